@@ -1,0 +1,53 @@
+# Fortran compiler flags. Included from the top level before any target exists, so
+# add_compile_options() reaches every Fortran target of the project (C sources are untouched).
+#
+# Why these flags:
+#   -ffp-contract=off   no fused multiply-add: results must not depend on what got inlined, the
+#                       single-file Abaqus build must match our library bit for bit, and Abaqus
+#                       itself compiles user subroutines without FMA.
+#   -ffree-line-length-none   generated test sources and long VUMAT argument lists.
+#   Debug               catch bad indices, NaN production and uninitialised reads early:
+#                       -finit-real=snan turns a read of an unset real into an FP trap.
+#
+# -fimplicit-none is NOT global: Abaqus user code includes vaba_param.inc, whose
+# `implicit double precision (a-h,o-z)` relies on the default i-n integer rule, which
+# -fimplicit-none removes (gfortran then rejects `nblock`). Targets that are pure modern
+# Fortran opt in with bulkflow_require_implicit_none(<target>...).
+
+if(NOT CMAKE_Fortran_COMPILER_ID STREQUAL "GNU")
+  message(WARNING "bulkflow's flags are written for gfortran; ${CMAKE_Fortran_COMPILER_ID} "
+                  "builds use CMake's defaults only.")
+  function(bulkflow_require_implicit_none)
+  endfunction()
+  return()
+endif()
+
+set(_bf_fortran_all -Wall -Wextra -ffree-line-length-none -ffp-contract=off)
+if(BULKFLOW_NATIVE)
+  list(APPEND _bf_fortran_all -march=native)
+endif()
+if(BULKFLOW_WERROR)
+  list(APPEND _bf_fortran_all -Werror)
+endif()
+set(_bf_fortran_release -O3 -funroll-loops)
+set(_bf_fortran_debug
+  -O0 -g -fbacktrace -fcheck=all -ffpe-trap=invalid,zero,overflow
+  -finit-real=snan -finit-integer=-99999999)
+
+# Quoted, so each list stays inside its generator expression; the ";" between flags splits them
+# into separate arguments once the expression is evaluated.
+add_compile_options(
+  "$<$<COMPILE_LANGUAGE:Fortran>:${_bf_fortran_all}>"
+  "$<$<AND:$<COMPILE_LANGUAGE:Fortran>,$<CONFIG:Release,RelWithDebInfo>>:${_bf_fortran_release}>"
+  "$<$<AND:$<COMPILE_LANGUAGE:Fortran>,$<CONFIG:Debug>>:${_bf_fortran_debug}>")
+
+# bulkflow_require_implicit_none(<target>...): reject any implicitly typed name in the target's
+# Fortran sources, as if every scope said `implicit none`.
+function(bulkflow_require_implicit_none)
+  foreach(target IN LISTS ARGN)
+    target_compile_options(${target} PRIVATE "$<$<COMPILE_LANGUAGE:Fortran>:-fimplicit-none>")
+  endforeach()
+endfunction()
+
+message(STATUS "bulkflow: build type ${CMAKE_BUILD_TYPE}, native=${BULKFLOW_NATIVE}, "
+               "werror=${BULKFLOW_WERROR}")

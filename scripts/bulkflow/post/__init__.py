@@ -1,0 +1,1 @@
+"""Post-processing of bulkflow output files (CSV histories, HDF5 frames)."""

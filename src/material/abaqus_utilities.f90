@@ -1,0 +1,83 @@
+! Abaqus/Explicit utility routines that user subroutines call (vgetvrm, xplb_abqerr,
+! xplb_exit), provided by the bulkflow host with Abaqus's argument lists. They are external
+! procedures on purpose: user code calls them without an interface, exactly as in Abaqus.
+
+!> Start-of-increment values of an output variable for the current block.
+!> Supported keys: 'S' (stress), 'LE' (logarithmic strain); others return jStatus = 1.
+subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
+  use material_kinds, only: dp
+  use abaqus_host, only: host_get_variable
+  implicit none
+  character(len=*), intent(in) :: cVar
+  real(dp), intent(out) :: rData(*)
+  integer, intent(out) :: jData(*)
+  character(len=3), intent(out) :: cData(*)
+  integer, intent(inout) :: jStatus
+
+  jData(1) = 0
+  cData(1) = ' '
+  call host_get_variable(cVar, rData, jStatus)
+end subroutine vgetvrm
+
+!> Message from user code. lop: 1 information, -1 warning, -2 error, -3 error and stop.
+!> %I, %R and %S in the text are replaced by successive entries of intv, realv and charv.
+subroutine xplb_abqerr(lop, string, intv, realv, charv)
+  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+  use material_kinds, only: dp
+  use abaqus_host, only: host_exit
+  implicit none
+  integer, intent(in) :: lop
+  character(len=*), intent(in) :: string
+  integer, intent(in) :: intv(*)
+  real(dp), intent(in) :: realv(*)
+  character(len=8), intent(in) :: charv(*)
+  character(len=:), allocatable :: text
+  character(len=32) :: number
+  integer :: i, ni, nr, ns
+
+  text = ''
+  ni = 0; nr = 0; ns = 0
+  i = 1
+  do while (i <= len_trim(string))
+     if (string(i:i) == '%' .and. i < len_trim(string)) then
+        select case (string(i + 1:i + 1))
+        case ('I', 'i')
+           ni = ni + 1
+           write (number, '(i0)') intv(ni)
+           text = text // trim(number)
+           i = i + 2
+           cycle
+        case ('R', 'r')
+           nr = nr + 1
+           write (number, '(es14.6)') realv(nr)
+           text = text // trim(adjustl(number))
+           i = i + 2
+           cycle
+        case ('S', 's')
+           ns = ns + 1
+           text = text // trim(charv(ns))
+           i = i + 2
+           cycle
+        end select
+     end if
+     text = text // string(i:i)
+     i = i + 1
+  end do
+
+  select case (lop)
+  case (1)
+     write (output_unit, '(a)') 'bulkflow: user subroutine: ' // text
+  case (-1)
+     write (error_unit, '(a)') 'bulkflow: warning: user subroutine: ' // text
+  case default
+     write (error_unit, '(a)') 'bulkflow: error: ' // text
+     if (lop == -3) call host_exit(3)
+  end select
+end subroutine xplb_abqerr
+
+!> Stop the analysis on behalf of user code.
+subroutine xplb_exit()
+  use abaqus_host, only: host_exit
+  implicit none
+  call host_exit(3)
+end subroutine xplb_exit

@@ -1,0 +1,97 @@
+!> What happens inside one VUMAT call: pick the model from the material name, decode and
+!> check `props`, and update the block. Kept apart from the Abaqus-style entry point so that
+!> every argument here has an explicit type and intent.
+module material_dispatch
+  use material_kinds, only: dp
+  use material_props, only: model_from_name, model_names_help, model_unknown, model_elastic, &
+       model_mohr_coulomb, model_drucker_prager, message_length, mohr_coulomb_props_t, &
+       drucker_prager_props_t, decode_elastic, decode_mohr_coulomb, decode_drucker_prager
+  use material_update, only: update_elastic_block, update_mohr_coulomb_block, update_drucker_prager_block
+  implicit none
+  private
+
+  public :: material_vumat, message_length
+
+contains
+
+  !> One VUMAT call. On failure `ok` is false and `message` says why; the entry point
+  !> reports it through the host's error utilities (xplb_abqerr / xplb_exit).
+  subroutine material_vumat(nblock, ndir, nshr, nstatev, nfieldv, nprops, lanneal, step_time, &
+       total_time, cmname, props, density, strain_inc, field_new, stress_old, state_old, &
+       e_int_old, e_inel_old, stress_new, state_new, e_int_new, e_inel_new, ok, message)
+    integer, intent(in) :: nblock, ndir, nshr, nstatev, nfieldv, nprops, lanneal
+    real(dp), intent(in) :: step_time, total_time
+    character(len=*), intent(in) :: cmname
+    real(dp), intent(in) :: props(nprops), density(nblock)
+    real(dp), intent(in) :: strain_inc(nblock, ndir + nshr), field_new(nblock, nfieldv)
+    real(dp), intent(in) :: stress_old(nblock, ndir + nshr), state_old(nblock, nstatev)
+    real(dp), intent(in) :: e_int_old(nblock), e_inel_old(nblock)
+    real(dp), intent(out) :: stress_new(nblock, ndir + nshr), state_new(nblock, nstatev)
+    real(dp), intent(out) :: e_int_new(nblock), e_inel_new(nblock)
+    logical, intent(out) :: ok
+    character(len=message_length), intent(out) :: message
+    integer :: model, ncomp
+    real(dp) :: lam, shear
+    type(mohr_coulomb_props_t) :: mc
+    type(drucker_prager_props_t) :: dpp
+
+    ok = .false.
+    ncomp = ndir + nshr
+    if (ndir /= 3 .or. (nshr /= 1 .and. nshr /= 3)) then
+       write (message, '(a,i0,a,i0,a)') 'material ' // trim(cmname) // ': ndir = ', ndir, ', nshr = ', nshr, &
+            ' is not supported (plane strain/axisymmetric 3,1 or 3D 3,3; no plane stress)'
+       return
+    end if
+    model = model_from_name(cmname)
+    if (model == model_unknown) then
+       message = 'unknown material name "' // trim(cmname) // '": ' // model_names_help()
+       return
+    end if
+
+    ! Validate first, whatever the call: bad props must stop the data check, not increment 1.
+    select case (model)
+    case (model_elastic)
+       call decode_elastic(props, nprops, lam, shear, ok, message)
+    case (model_mohr_coulomb)
+       call decode_mohr_coulomb(props, nprops, nstatev, nfieldv, mc, ok, message)
+       lam = mc%lam; shear = mc%shear
+    case (model_drucker_prager)
+       call decode_drucker_prager(props, nprops, nstatev, dpp, ok, message)
+       lam = dpp%lam; shear = dpp%shear
+    end select
+    if (.not. ok) then
+       message = 'material ' // trim(cmname) // ': ' // trim(message)
+       return
+    end if
+
+    e_inel_new = e_inel_old
+    if (lanneal == 1) then
+       ! Annealing: Abaqus zeroes stresses; the plastic history goes with them.
+       stress_new = 0
+       state_new = 0
+       e_int_new = e_int_old
+       return
+    end if
+    if (max(abs(step_time), abs(total_time)) < tiny(1.0_dp)) then
+       ! Packaging call: the host only wants the elastic response to size the wave speed.
+       call update_elastic_block(nblock, ncomp, lam, shear, density, strain_inc, stress_old, stress_new, &
+            e_int_old, e_int_new)
+       state_new = state_old
+       return
+    end if
+
+    select case (model)
+    case (model_elastic)
+       call update_elastic_block(nblock, ncomp, lam, shear, density, strain_inc, stress_old, stress_new, &
+            e_int_old, e_int_new)
+       state_new = state_old
+    case (model_mohr_coulomb)
+       call update_mohr_coulomb_block(nblock, ncomp, nstatev, nfieldv, nprops, props, mc, total_time, &
+            density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, &
+            e_int_old, e_int_new, e_inel_old, e_inel_new)
+    case (model_drucker_prager)
+       call update_drucker_prager_block(nblock, ncomp, nstatev, dpp, density, strain_inc, stress_old, &
+            state_old, stress_new, state_new, e_int_old, e_int_new, e_inel_old, e_inel_new)
+    end select
+  end subroutine material_vumat
+end module material_dispatch

@@ -1,0 +1,322 @@
+!> Spectral decomposition of symmetric stress (or strain) tensors for the principal-space
+!> material returns, and the inverse rotation back to the component basis.
+!>
+!> This module owns:
+!>   * principal_plane / rebuild_plane  — plane strain (components 11,22,33,12; 33 is principal);
+!>   * principal_3d    / rebuild_3d     — 3D (components 11,22,33,12,23,31, the VUMAT order).
+!> Principal values come out sorted σ1 ≥ σ2 ≥ σ3 (tension positive, σ3 most compressive).
+!> The rebuild routines accept *any* diagonal values in the stored basis, so they also rotate
+!> principal plastic strains back (tensor shear components, like the stresses).
+!>
+!> Everything is pure, branch-light (merge() selections, no sort loops, no acos/cos) and has
+!> explicit-shape dummies only, so that gfortran -O3 can inline it into a block loop over
+!> material points. No routine divides by zero: zero, isotropic and repeated-root tensors are
+!> handled explicitly, and magnitudes far from 1 (|s| < 1e-100 or > 1e100 in 3D, deviator
+!> outside [1e-150, 1e150] in the plane) are scaled by exact powers of two first.
+!>
+!> Accuracy: rebuild(principal(s)) reproduces s to a few ulp of max|s_ij| (≤ ~2e-15 relative
+!> over 2·10^6 random tensors incl. double, triple and nearly repeated roots and magnitudes
+!> 1e-150..1e150; unit tests ask for 1e-13), eigenvectors are orthonormal to ~1.5e-15.
+!> Cost (gfortran 12 -O3, not inlined, one AMD EPYC core): principal_plane ≈ 10 ns,
+!> principal_3d ≈ 95 ns; the 3D time is the latency of its sqrt/div chain.
+module principal_stress
+  use material_kinds, only: dp
+  implicit none
+  private
+
+  public :: principal_plane, rebuild_plane, principal_3d, rebuild_3d
+
+  !> Absolute floor of the deviator size p in principal_3d_core: below it the tensor is treated
+  !> as isotropic, which keeps 1/p finite (inputs there are pre-scaled to max|s_ij| ≥ 1e-100, so
+  !> only an exactly or nearly isotropic tensor can get this low).
+  real(dp), parameter :: radius_floor = sqrt(tiny(1.0_dp))
+
+contains
+
+  !> Principal stresses of a plane-strain tensor s = (11, 22, 33, 12).
+  !> sig   : sorted descending (σ1 ≥ σ2 ≥ σ3);
+  !> c, sn : cosine and sine of the angle θ from x to the major *in-plane* principal direction
+  !>         (eigenvector (c, sn, 0) belongs to the larger in-plane value σa);
+  !> izz   : slot of the out-of-plane value s33 in sig (1, 2 or 3). The in-plane values σa ≥ σb
+  !>         fill the other two slots in that order.
+  pure subroutine principal_plane(s, sig, c, sn, izz)
+    real(dp), intent(in) :: s(4)
+    real(dp), intent(out) :: sig(3)
+    real(dp), intent(out) :: c, sn
+    integer, intent(out) :: izz
+    real(dp) :: sa, sb, szz
+
+    call sym2_eigen(s(1), s(2), s(4), sa, sb, c, sn)
+    szz = s(3)
+    ! Three values with sa >= sb already known: two compares place szz.
+    if (szz >= sa) then
+       sig(1) = szz
+       sig(2) = sa
+       sig(3) = sb
+       izz = 1
+    else if (szz >= sb) then
+       sig(1) = sa
+       sig(2) = szz
+       sig(3) = sb
+       izz = 2
+    else
+       sig(1) = sa
+       sig(2) = sb
+       sig(3) = szz
+       izz = 3
+    end if
+  end subroutine principal_plane
+
+  !> Inverse of principal_plane: s = σa e_a⊗e_a + σb e_b⊗e_b + σzz e_z⊗e_z with the stored
+  !> angle (c, sn) and slot izz. Works for any three values in that basis (e.g. principal plastic
+  !> strains), not only for sorted ones; s(4) is the tensor shear component.
+  pure subroutine rebuild_plane(sig, c, sn, izz, s)
+    real(dp), intent(in) :: sig(3)
+    real(dp), intent(in) :: c, sn
+    integer, intent(in) :: izz
+    real(dp), intent(out) :: s(4)
+    real(dp) :: sa, sb, szz, cc, ss
+
+    select case (izz)
+    case (1)
+       szz = sig(1)
+       sa = sig(2)
+       sb = sig(3)
+    case (2)
+       sa = sig(1)
+       szz = sig(2)
+       sb = sig(3)
+    case default
+       sa = sig(1)
+       sb = sig(2)
+       szz = sig(3)
+    end select
+    cc = c * c
+    ss = sn * sn
+    s(1) = sa * cc + sb * ss
+    s(2) = sa * ss + sb * cc
+    s(3) = szz
+    s(4) = (sa - sb) * c * sn
+  end subroutine rebuild_plane
+
+  !> Principal values and unit eigenvectors of a symmetric 3x3 tensor s = (11,22,33,12,23,31).
+  !> sig sorted descending; vec(:, i) is the unit eigenvector of sig(i); the triad is
+  !> orthonormal (its handedness is not fixed).
+  !>
+  !> Method (non-iterative apart from one fixed Newton step, robust for repeated roots):
+  !>  1. shift by the mean q and scale the deviator by p = sqrt(tr(B²)/6): the scaled deviator
+  !>     C has eigenvalues 2cos(·) in [-2, 2] and no overflow/underflow can occur;
+  !>  2. the root of μ³ − 3μ − 2r = 0 (r = det C / 2) that is *separated* from the other two —
+  !>     the largest for r ≥ 0, the smallest for r < 0 — lies at least √3 away from both others.
+  !>     It is the trigonometric root ±2cos(acos|r|/3), evaluated here without acos/cos: a
+  !>     degree-8 fit in |r| (error < 1e-8) and one Newton step give it to an ulp (f' ≥ 6);
+  !>  3. its eigenvector is the largest cross product of two rows of C − μI (squared norm ≥ 3
+  !>     in exact arithmetic), accurate to ~ulp whatever the other two roots do;
+  !>  4. C is projected exactly onto the plane orthogonal to that vector and the 2x2 problem is
+  !>     solved in closed form (exact for double roots); the separated value follows from the
+  !>     trace. Because C is projected onto the computed triad, the reconstruction error stays at
+  !>     rounding level even when two roots nearly coincide, where the cubic formula alone would
+  !>     lose half the digits of the close pair.
+  !> Isotropic tensors (deviator at rounding level of the mean) return the identity triad.
+  !> The selections use merge() so that gfortran emits blends instead of unpredictable branches.
+  !> Tensors with max|s_ij| outside [1e-100, 1e100] are first scaled by an exact power of two,
+  !> so squares and cubes of their components can neither underflow nor overflow.
+  pure subroutine principal_3d(s, sig, vec)
+    real(dp), intent(in) :: s(6)
+    real(dp), intent(out) :: sig(3)
+    real(dp), intent(out) :: vec(3, 3)
+    real(dp) :: amax
+    integer :: e
+
+    amax = max(abs(s(1)), abs(s(2)), abs(s(3)), abs(s(4)), abs(s(5)), abs(s(6)))
+    if (amax > 1.0e-100_dp .and. amax < 1.0e100_dp) then
+       call principal_3d_core(s, sig, vec)
+    else
+       e = exponent(amax)
+       call principal_3d_core(scale(s, -e), sig, vec)
+       sig = scale(sig, e)
+    end if
+  end subroutine principal_3d
+
+  !> principal_3d for max|s_ij| in [1e-100, 1e100] (see principal_3d).
+  pure subroutine principal_3d_core(s, sig, vec)
+    real(dp), intent(in) :: s(6)
+    real(dp), intent(out) :: sig(3)
+    real(dp), intent(out) :: vec(3, 3)
+    ! Degree-8 fit of 2cos(acos(ρ)/3) on [0, 1] (Chebyshev least squares, max error 8.6e-9;
+    ! one Newton step then lands within an ulp).
+    real(dp), parameter :: f0 = 1.7320508160829569_dp, f1 = 0.33333253539506985_dp
+    real(dp), parameter :: f2 = -0.09620655020681854_dp, f3 = 0.04919767526830958_dp
+    real(dp), parameter :: f4 = -0.030190554045480565_dp, f5 = 0.01874415728341634_dp
+    real(dp), parameter :: f6 = -0.009859042862492647_dp, f7 = 0.0035427520895337217_dp
+    real(dp), parameter :: f8 = -0.0006117952499170653_dp
+    real(dp), parameter :: third = 1.0_dp / 3.0_dp
+    real(dp) :: q, b11, b22, b33, p2, p, ip
+    real(dp) :: c11, c22, c33, c12, c23, c13, r, rho, rho2, rho4, mu, mm
+    real(dp) :: x01(3), x02(3), x12(3), n01, n02, n12, x(3), nx, inv_x, inv_u, v(3), u(3), w(3)
+    real(dp) :: cu(3), cw(3), a11, a22, a12, mu_a, mu_b, cs, sn, mu_s, ea(3), eb(3)
+    logical :: top
+
+    q = (s(1) + s(2) + s(3)) * third
+    b11 = s(1) - q
+    b22 = s(2) - q
+    b33 = s(3) - q
+    p2 = (b11 * b11 + b22 * b22 + b33 * b33 &
+         + 2.0_dp * (s(4) * s(4) + s(5) * s(5) + s(6) * s(6))) * (1.0_dp / 6.0_dp)
+    ! Isotropic (incl. zero) tensor: every triad is a valid eigenbasis. The threshold is
+    ! ulp-level relative to the mean plus an absolute floor that keeps 1/p finite.
+    if (p2 <= max(radius_floor**2, (4.0_dp * epsilon(1.0_dp) * q)**2)) then
+       sig = q
+       vec = 0.0_dp
+       vec(1, 1) = 1.0_dp
+       vec(2, 2) = 1.0_dp
+       vec(3, 3) = 1.0_dp
+       return
+    end if
+    p = sqrt(p2)
+    ip = 1.0_dp / p
+    c11 = b11 * ip
+    c22 = b22 * ip
+    c33 = b33 * ip
+    c12 = s(4) * ip
+    c23 = s(5) * ip
+    c13 = s(6) * ip
+
+    ! r = det(C)/2 = cos(3φ); clamp the rounding excursions beyond ±1.
+    r = 0.5_dp * (c11 * (c22 * c33 - c23 * c23) - c12 * (c12 * c33 - c23 * c13) &
+         + c13 * (c12 * c23 - c22 * c13))
+    rho = min(abs(r), 1.0_dp)
+    ! Estrin's scheme keeps the polynomial's dependency chain short.
+    rho2 = rho * rho
+    rho4 = rho2 * rho2
+    mu = ((f0 + f1 * rho) + (f2 + f3 * rho) * rho2) &
+         + ((f4 + f5 * rho) + (f6 + f7 * rho) * rho2) * rho4 + f8 * (rho4 * rho4)
+    mm = mu * mu
+    mu = mu - (mu * (mm - 3.0_dp) - 2.0_dp * rho) / (3.0_dp * (mm - 1.0_dp))
+    ! The smallest root for r < 0 is the mirror image of the largest root for |r|.
+    top = r >= 0.0_dp
+    mu = merge(mu, -mu, top)
+
+    ! Rows of C − μI and their cross products; the largest is the separated eigenvector.
+    x01 = cross(c11 - mu, c12, c13, c12, c22 - mu, c23)
+    x02 = cross(c11 - mu, c12, c13, c13, c23, c33 - mu)
+    x12 = cross(c12, c22 - mu, c23, c13, c23, c33 - mu)
+    n01 = dot_product(x01, x01)
+    n02 = dot_product(x02, x02)
+    n12 = dot_product(x12, x12)
+    x = merge(x01, merge(x02, x12, n02 >= n12), n01 >= max(n02, n12))
+    nx = max(n01, n02, n12)
+    if (.not. nx > 1.0e-6_dp) then
+       ! Unreachable for finite input (nx ≥ 3 in exact arithmetic); no path divides by zero.
+       x = [1.0_dp, 0.0_dp, 0.0_dp]
+       nx = 1.0_dp
+    end if
+    ! Orthonormal triad (v, u, w). u is built from the unnormalised x (its larger pair of
+    ! components keeps |u|² ≥ |x|²/2), so the two normalisations run in parallel.
+    u = merge([-x(3), 0.0_dp, x(1)], [0.0_dp, x(3), -x(2)], abs(x(1)) > abs(x(2)))
+    w = cross(x(1), x(2), x(3), u(1), u(2), u(3))
+    inv_x = 1.0_dp / sqrt(nx)
+    inv_u = 1.0_dp / sqrt(dot_product(u, u))
+    v = x * inv_x
+    w = w * (inv_x * inv_u)
+    u = u * inv_u
+
+    ! Exact projection of C on (u, w); the separated value from the trace.
+    cu = matvec(c11, c22, c33, c12, c23, c13, u)
+    cw = matvec(c11, c22, c33, c12, c23, c13, w)
+    a11 = dot_product(u, cu)
+    a22 = dot_product(w, cw)
+    a12 = dot_product(u, cw)
+    mu_s = (c11 + c22 + c33) - a11 - a22
+    call sym2_eigen(a11, a22, a12, mu_a, mu_b, cs, sn)
+    ea = cs * u + sn * w
+    eb = cs * w - sn * u
+
+    ! The separated root is the largest (r ≥ 0) or the smallest (r < 0) with a gap ≥ √3 to the
+    ! others, so its position needs no comparison.
+    sig(1) = q + p * merge(mu_s, mu_a, top)
+    sig(2) = q + p * merge(mu_a, mu_b, top)
+    sig(3) = q + p * merge(mu_b, mu_s, top)
+    vec(:, 1) = merge(v, ea, top)
+    vec(:, 2) = merge(ea, eb, top)
+    vec(:, 3) = merge(eb, v, top)
+  end subroutine principal_3d_core
+
+  !> Inverse of principal_3d: s = Σ_i sig(i) vec(:,i)⊗vec(:,i), components (11,22,33,12,23,31).
+  !> Any diagonal values in the basis vec are accepted (principal plastic strains included).
+  pure subroutine rebuild_3d(sig, vec, s)
+    real(dp), intent(in) :: sig(3)
+    real(dp), intent(in) :: vec(3, 3)
+    real(dp), intent(out) :: s(6)
+    real(dp) :: a(3), b(3), cc(3)
+
+    a = sig(1) * vec(:, 1)
+    b = sig(2) * vec(:, 2)
+    cc = sig(3) * vec(:, 3)
+    s(1) = a(1) * vec(1, 1) + b(1) * vec(1, 2) + cc(1) * vec(1, 3)
+    s(2) = a(2) * vec(2, 1) + b(2) * vec(2, 2) + cc(2) * vec(2, 3)
+    s(3) = a(3) * vec(3, 1) + b(3) * vec(3, 2) + cc(3) * vec(3, 3)
+    s(4) = a(1) * vec(2, 1) + b(1) * vec(2, 2) + cc(1) * vec(2, 3)
+    s(5) = a(2) * vec(3, 1) + b(2) * vec(3, 2) + cc(2) * vec(3, 3)
+    s(6) = a(3) * vec(1, 1) + b(3) * vec(1, 2) + cc(3) * vec(1, 3)
+  end subroutine rebuild_3d
+
+  !> Closed-form eigen-pair of the symmetric 2x2 matrix [[a11, a12], [a12, a22]]:
+  !> mu_a ≥ mu_b, (c, sn) the unit eigenvector of mu_a. With d = (a11 − a22)/2 and
+  !> ρ = sqrt(d² + a12²) that eigenvector is (d + ρ, a12) for d ≥ 0 and (a12, ρ − d) for d < 0;
+  !> both are written with t = |d| + ρ, whose squared norm t² + a12² = 2ρ(ρ + |d|) suffers no
+  !> cancellation, so c² + sn² = 1 to rounding without atan2/cos/sin. A double root keeps the
+  !> current axes. Deviators outside [1e-150, 1e150] are scaled by an exact power of two first
+  !> (rare, predictable branch), so d² + a12² never underflows or overflows.
+  pure subroutine sym2_eigen(a11, a22, a12, mu_a, mu_b, c, sn)
+    real(dp), intent(in) :: a11, a22, a12
+    real(dp), intent(out) :: mu_a, mu_b, c, sn
+    real(dp) :: mid, d, o, amax, rho, rs, t, inv
+    integer :: e
+    logical :: pos
+
+    mid = 0.5_dp * (a11 + a22)
+    d = 0.5_dp * (a11 - a22)
+    o = a12
+    amax = max(abs(d), abs(o))
+    if (amax > 1.0e-150_dp .and. amax < 1.0e150_dp) then
+       rho = sqrt(d * d + o * o)
+       t = abs(d) + rho
+    else if (amax > 0.0_dp) then
+       e = exponent(amax)
+       t = scale(abs(d), -e)
+       o = scale(o, -e)
+       rs = sqrt(t * t + o * o)
+       rho = scale(rs, e)
+       t = t + rs
+    else
+       rho = 0.0_dp
+       t = 1.0_dp
+    end if
+    mu_a = mid + rho
+    mu_b = mid - rho
+    inv = 1.0_dp / sqrt(t * t + o * o)
+    pos = d >= 0.0_dp
+    c = merge(t, o, pos) * inv
+    sn = merge(o, t, pos) * inv
+  end subroutine sym2_eigen
+
+  pure function cross(a1, a2, a3, b1, b2, b3) result(x)
+    real(dp), intent(in) :: a1, a2, a3, b1, b2, b3
+    real(dp) :: x(3)
+    x(1) = a2 * b3 - a3 * b2
+    x(2) = a3 * b1 - a1 * b3
+    x(3) = a1 * b2 - a2 * b1
+  end function cross
+
+  pure function matvec(c11, c22, c33, c12, c23, c13, x) result(y)
+    real(dp), intent(in) :: c11, c22, c33, c12, c23, c13
+    real(dp), intent(in) :: x(3)
+    real(dp) :: y(3)
+    y(1) = c11 * x(1) + c12 * x(2) + c13 * x(3)
+    y(2) = c12 * x(1) + c22 * x(2) + c23 * x(3)
+    y(3) = c13 * x(1) + c23 * x(2) + c33 * x(3)
+  end function matvec
+
+
+end module principal_stress
