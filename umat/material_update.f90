@@ -211,7 +211,8 @@ contains
   !> ½(σ_old + σ_new):Δε with tensor shear components counted twice.
   pure real(dp) function stress_power(ncomp, s_old, s_new, deps)
     integer, intent(in) :: ncomp
-    real(dp), intent(in) :: s_old(ncomp), s_new(ncomp), deps(ncomp)
+    ! Assumed shape: callers pass rows of (nblock, ncomp) blocks without a copy.
+    real(dp), intent(in) :: s_old(:), s_new(:), deps(:)
 
     stress_power = 0.5_dp * (sum((s_old(1:3) + s_new(1:3)) * deps(1:3)) &
          + 2 * sum((s_old(4:ncomp) + s_new(4:ncomp)) * deps(4:ncomp)))

@@ -24,9 +24,16 @@
 !> t1 ∝ 3(p−σa)/(2+k), t2 ∝ 3(p−σa)/(1+2k)); all denominators are sums of positive terms for
 !> every ψ in [0, φ] and every λ > −2G/3 (bulk modulus > 0), so no ψ = 0 branch is needed.
 !>
-!> The plain Mohr–Coulomb path is closed form and small enough to inline into a block loop.
-!> The cut-off (rarely active) is an active-set solve over the few candidate plane sets of the
-!> sorted sextant (numerics.md §1.7), entered only when the Mohr–Coulomb result violates σ1 ≤ σt.
+!> Apex: the region test is Clausen's (t1 > 0 and t2 > 0). For ψ > 0 and trial states in the
+!> cone of the corrector directions this is the KKT apex return; for ψ = 0 (and for small ψ with
+!> trial states far on the tensile side) no plastic corrector of the flow rule can reach the
+!> surface, and the apex is taken by definition ("tensile separation", numerics.md §1.3), with a
+!> volumetric plastic strain even for ψ = 0.
+!>
+!> The plain Mohr–Coulomb path is closed form (about 10-20 ns per call) and small enough to
+!> inline into a block loop. The cut-off is entered only when the Mohr–Coulomb result violates
+!> σ1 ≤ σt: the Rankine return alone in closed form (about 25 ns), and only where Mohr–Coulomb is
+!> active as well an active-set solve over the candidate plane sets (numerics.md §1.7).
 module mohr_coulomb_return
   use material_kinds, only: dp
   implicit none
@@ -186,16 +193,22 @@ contains
     m_of = (1.0_dp + sin_psi) / (1.0_dp - sin_psi)
   end function m_of
 
-  !> Combined Mohr–Coulomb + Rankine return by an active-set solve in the sorted sextant.
+  !> Combined Mohr–Coulomb + Rankine return in the sorted sextant (numerics.md §1.7).
   !> Planes: 1 MC main (a = (k,0,−1), b = (m,0,−1)), 2 MC σ1=σ2 side (a = (0,k,−1)),
   !> 3 MC σ2=σ3 side (a = (k,−1,0)), 4..6 Rankine σ1, σ2, σ3 ≤ σt (associated, a = b = e_i).
-  !> For a candidate set S the consistency conditions Σ_j (a_iᵀ D b_j) Δλ_j = f_i(σB), i ∈ S,
-  !> are solved; the set is accepted when all Δλ_j ≥ 0 and every plane is satisfied at the
-  !> result (numerics.md §1.7). Candidates, in order: {R1}, {MC,R1}, {R1,R2},
-  !> {MC,MC3,R1} (extension corner), the four non-singular triples of {MC,MC2,R1,R2}
-  !> (compression corner, where four planes meet), {R1,R2,R3} (Rankine apex). If round-off
-  !> rejects every set, the candidate with the smallest violation is used, so the routine always
-  !> returns an admissible-to-rounding stress.
+  !>
+  !> 1. The Rankine return alone, in closed form (plane: Δλ1 = (σB1−σt)/(λ+2G); edge: the 2x2
+  !>    system with determinant 4G(λ+G) > 0; else apex σt(1,1,1)). If its result satisfies
+  !>    Mohr–Coulomb it is a KKT point of the combined surface and is taken: this is the usual
+  !>    case (material pulled apart), and it costs a few flops.
+  !> 2. Otherwise Mohr–Coulomb is active too: candidate active sets S are tried in order,
+  !>    {MC,R1} (line), {MC,MC3,R1} (extension corner), the four non-singular triples of
+  !>    {MC,MC2,R1,R2} (compression corner, where four planes meet), then the Rankine-only sets.
+  !>    For each, Σ_j (a_iᵀ D b_j) Δλ_j = f_i(σB), i ∈ S, is solved by Cramer's rule and the set
+  !>    is accepted when all Δλ_j ≥ 0 and every plane holds at the result. If round-off rejects
+  !>    every set, the candidate with the smallest violation is used.
+  !> Finally the active coordinates are set exactly and the result is clamped into the admissible
+  !> set, so a second call finds it elastic.
   pure subroutine tension_cutoff_return(sig_trial, k, m, sigc, sigma_t, lam, shear, scale, &
        sig, detail)
     real(dp), intent(in) :: sig_trial(3), k, m, sigc, sigma_t, lam, shear, scale
@@ -204,49 +217,73 @@ contains
     integer, parameter :: ncand = 9
     ! Plane indices of each candidate (0 = unused) and its reported sub-region.
     integer, parameter :: sets(3, ncand) = reshape([ &
-         4, 0, 0, &
          1, 4, 0, &
-         4, 5, 0, &
          1, 3, 4, &
          1, 2, 4, &
          1, 4, 5, &
          2, 4, 5, &
          1, 2, 5, &
+         4, 0, 0, &
+         4, 5, 0, &
          4, 5, 6], [3, ncand])
-    integer, parameter :: set_detail(ncand) = [cutoff_plane, cutoff_mc_line, cutoff_edge, &
-         cutoff_corner_extension, cutoff_corner_compression, cutoff_corner_compression, &
-         cutoff_corner_compression, cutoff_corner_compression, cutoff_apex]
+    integer, parameter :: set_detail(ncand) = [cutoff_mc_line, cutoff_corner_extension, &
+         cutoff_corner_compression, cutoff_corner_compression, cutoff_corner_compression, &
+         cutoff_corner_compression, cutoff_plane, cutoff_edge, cutoff_apex]
     real(dp) :: a(3, 6), db(3, 6), rhs(6), trial_sig(3), viol, best_viol
+    real(dp) :: mp, e1, e2, d1, det, dl1, dl2, s3
     integer :: ic
 
-    a(:, 1) = [k, 0.0_dp, -1.0_dp]
-    a(:, 2) = [0.0_dp, k, -1.0_dp]
-    a(:, 3) = [k, -1.0_dp, 0.0_dp]
-    a(:, 4) = [1.0_dp, 0.0_dp, 0.0_dp]
-    a(:, 5) = [0.0_dp, 1.0_dp, 0.0_dp]
-    a(:, 6) = [0.0_dp, 0.0_dp, 1.0_dp]
-    db(:, 1) = elastic_principal(lam, shear, [m, 0.0_dp, -1.0_dp])
-    db(:, 2) = elastic_principal(lam, shear, [0.0_dp, m, -1.0_dp])
-    db(:, 3) = elastic_principal(lam, shear, [m, -1.0_dp, 0.0_dp])
-    db(:, 4) = elastic_principal(lam, shear, a(:, 4))
-    db(:, 5) = elastic_principal(lam, shear, a(:, 5))
-    db(:, 6) = elastic_principal(lam, shear, a(:, 6))
-    rhs(1:3) = sigc
-    rhs(4:6) = sigma_t
-
-    best_viol = huge(1.0_dp)
-    sig = sig_trial
-    detail = cutoff_plane
-    do ic = 1, ncand
-       call try_active_set(sets(:, ic), a, db, rhs, sig_trial, scale, trial_sig, viol)
-       if (viol < best_viol) then
-          best_viol = viol
-          sig = trial_sig
-          detail = set_detail(ic)
+    ! 1. Rankine alone.
+    mp = lam + 2.0_dp * shear
+    e1 = sig_trial(1) - sigma_t
+    e2 = sig_trial(2) - sigma_t
+    d1 = e1 / mp
+    if (e2 - lam * d1 <= 0.0_dp) then
+       sig = [sigma_t, sig_trial(2) - lam * d1, sig_trial(3) - lam * d1]
+       detail = cutoff_plane
+    else
+       det = 4.0_dp * shear * (lam + shear)
+       dl1 = (mp * e1 - lam * e2) / det
+       dl2 = (mp * e2 - lam * e1) / det
+       s3 = sig_trial(3) - lam * (dl1 + dl2)
+       if (s3 <= sigma_t) then
+          sig = [sigma_t, sigma_t, s3]
+          detail = cutoff_edge
+       else
+          sig = sigma_t
+          detail = cutoff_apex
        end if
-       if (viol <= set_tolerance) exit
-    end do
-    ! Exact coordinates of the active planes (the solve reproduces them to rounding only).
+    end if
+
+    ! 2. Mohr–Coulomb violated there: active-set search including the Mohr–Coulomb planes.
+    if (k * sig(1) - sig(3) - sigc > set_tolerance * scale) then
+       a(:, 1) = [k, 0.0_dp, -1.0_dp]
+       a(:, 2) = [0.0_dp, k, -1.0_dp]
+       a(:, 3) = [k, -1.0_dp, 0.0_dp]
+       a(:, 4) = [1.0_dp, 0.0_dp, 0.0_dp]
+       a(:, 5) = [0.0_dp, 1.0_dp, 0.0_dp]
+       a(:, 6) = [0.0_dp, 0.0_dp, 1.0_dp]
+       db(:, 1) = elastic_principal(lam, shear, [m, 0.0_dp, -1.0_dp])
+       db(:, 2) = elastic_principal(lam, shear, [0.0_dp, m, -1.0_dp])
+       db(:, 3) = elastic_principal(lam, shear, [m, -1.0_dp, 0.0_dp])
+       db(:, 4) = elastic_principal(lam, shear, a(:, 4))
+       db(:, 5) = elastic_principal(lam, shear, a(:, 5))
+       db(:, 6) = elastic_principal(lam, shear, a(:, 6))
+       rhs(1:3) = sigc
+       rhs(4:6) = sigma_t
+       best_viol = huge(1.0_dp)
+       do ic = 1, ncand
+          call try_active_set(sets(:, ic), a, db, rhs, sig_trial, scale, trial_sig, viol)
+          if (viol < best_viol) then
+             best_viol = viol
+             sig = trial_sig
+             detail = set_detail(ic)
+          end if
+          if (viol <= set_tolerance) exit
+       end do
+    end if
+
+    ! Exact coordinates of the active planes (the solves reproduce them to rounding only).
     sig(1) = sigma_t
     select case (detail)
     case (cutoff_mc_line)

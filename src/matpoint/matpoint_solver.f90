@@ -8,8 +8,11 @@
 !> difference that is an exact use of the VUMAT contract, not an approximation of the
 !> state. Newton stops when max|r| <= tolerance × stress scale (default 1e-12). A singular
 !> finite-difference Jacobian (e.g. perfect plasticity at the limit) is replaced by the
-!> elastic stiffness from the packaging call; no convergence is reported as an error at
-!> the stage's file:line, never as NaN.
+!> elastic stiffness from the packaging call. When an iteration gains less than a factor 10
+!> the answer sits on a kink of the response (a Mohr-Coulomb edge, the elastic-plastic
+!> transition), where one-sided differences mislead; Broyden updates then make the Jacobian
+!> exact along the steps taken (a handful of iterations instead of dozens). No convergence
+!> is reported as an error at the stage's file:line, never as NaN.
 !>
 !> Sequence: packaging call (moduli for the first guess), then for every increment of
 !> every stage: [vusdfld] + vumat on the block, Newton update, accept point 1. The whole

@@ -43,21 +43,21 @@ contains
     select case (icase)
     case (1, 2)
        cmname = 'ELASTIC-CHECK'
-       props = [10.0e6_dp, 0.3_dp]
+       call set_props(props, [10.0e6_dp, 0.3_dp])
     case (3, 4)
        ! Mohr-Coulomb with an angle table on field 1, bilinear flow function, tension cut-off.
        cmname = 'MC-CHECK'
-       props = [10.0e6_dp, 0.25_dp, 30.0_dp, 5.0_dp, 2.0e3_dp, 1.0_dp, 500.0_dp, 2.0_dp, 1.9e3_dp, 0.6_dp, &
+       call set_props(props, [10.0e6_dp, 0.25_dp, 30.0_dp, 5.0_dp, 2.0e3_dp, 1.0_dp, 500.0_dp, 2.0_dp, 1.9e3_dp, 0.6_dp, &
             0.3_dp, 0.0_dp, 2.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, &
-            46.0_dp, 15.0_dp, 0.0_dp, 34.0_dp, 0.0_dp, 0.2_dp]
+            46.0_dp, 15.0_dp, 0.0_dp, 34.0_dp, 0.0_dp, 0.2_dp])
     case (5)
        ! Cohesionless Mohr-Coulomb, zero dilation, cohesion table against PEEQ.
        cmname = 'MOHRCOULOMB_CHECK'
-       props = [8.0e6_dp, 0.3_dp, 34.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
-            0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 2.0_dp, 0.0_dp, 3.0e3_dp, 0.0_dp, 1.0e3_dp, 0.05_dp]
+       call set_props(props, [8.0e6_dp, 0.3_dp, 34.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
+            0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 2.0_dp, 0.0_dp, 3.0e3_dp, 0.0_dp, 1.0e3_dp, 0.05_dp])
     case default
        cmname = 'DP-CHECK'
-       props = [10.0e6_dp, 0.2_dp, 30.0_dp, 10.0_dp, 1.0e3_dp, 1.0_dp]
+       call set_props(props, [10.0e6_dp, 0.2_dp, 30.0_dp, 10.0_dp, 1.0e3_dp, 1.0_dp])
     end select
     nprops = size(props)
 
@@ -109,6 +109,16 @@ contains
        e_inel_old = e_inel_new
     end do
   end subroutine replay_case
+
+  !> Explicit allocation: gfortran 12 warns falsely (-Wmaybe-uninitialized) on reallocation
+  !> by assignment of an array constructor.
+  subroutine set_props(props, values)
+    real(dp), allocatable, intent(inout) :: props(:)
+    real(dp), intent(in) :: values(:)
+    if (allocated(props)) deallocate(props)
+    allocate(props(size(values)))
+    props(:) = values
+  end subroutine set_props
 
   !> Random strain increments with a compressive, shearing bias so that every return region
   !> (and unloading) occurs during the replay.

@@ -1,0 +1,29 @@
+!> Materials and sections. Every material reaches the solver as a VUMAT call: built-in
+!> keywords (*ELASTIC, *MOHR COULOMB, *DRUCKER PRAGER, ...) are translated by the model
+!> builder into the name and props of our own VUMATs (umat/README.md); *USER MATERIAL keeps
+!> the user's name and constants.
+module model_materials
+  use material_kinds, only: dp
+  use model_sets, only: name_length
+  implicit none
+  private
+
+  type, public :: material_t
+     character(len=name_length) :: name = ''     !< the scene's name, upper case
+     character(len=80) :: vumat_name = ''        !< cmname handed to vumat/vusdfld
+     real(dp) :: density = 0
+     real(dp), allocatable :: props(:)
+     integer :: nstatev = 0                      !< *DEPVAR
+     integer :: nfieldv = 0                      !< 1 with *USER DEFINED FIELD (field 1), else 0
+     logical :: user_field = .false.             !< call vusdfld before vumat
+     logical :: user_material = .false.          !< props come from *USER MATERIAL
+     character(len=256) :: source = ''           !< file:line of *MATERIAL, for messages
+  end type material_t
+
+  !> *SOLID SECTION, ELSET=..., MATERIAL=... (data line: thickness for plane strain, default 1).
+  type, public :: section_t
+     character(len=name_length) :: elset = ''
+     integer :: material = 0                     !< index into model%materials
+     real(dp) :: thickness = 1
+  end type section_t
+end module model_materials

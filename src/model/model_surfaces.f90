@@ -1,0 +1,40 @@
+!> Surfaces: element-face surfaces of the deformable mesh (the nodes that touch walls) and
+!> analytic rigid surfaces (walls) that move with a reference node.
+module model_surfaces
+  use material_kinds, only: dp
+  use model_sets, only: name_length
+  implicit none
+  private
+
+  integer, parameter, public :: segment_line = 1
+  integer, parameter, public :: segment_arc = 2
+
+  !> *SURFACE, TYPE=ELEMENT: faces S1..S4 (CPE4R) or S1..S6 (C3D8R) of listed elements.
+  type, public :: element_surface_t
+     character(len=name_length) :: name = ''
+     integer, allocatable :: elems(:)   !< internal element indices
+     integer, allocatable :: faces(:)   !< face number of each entry (1..4 or 1..6)
+     integer, allocatable :: nodes(:)   !< the distinct internal nodes of those faces, ascending
+  end type element_surface_t
+
+  !> One piece of a 2D analytic rigid surface (*SURFACE, TYPE=SEGMENTS): a straight line
+  !> from p0 to p1, or a circular arc from p0 to p1 about `centre` (less than 180 degrees,
+  !> as Abaqus requires). Coordinates are those of the reference configuration.
+  type, public :: segment_t
+     integer :: kind = segment_line
+     real(dp) :: p0(2) = 0, p1(2) = 0, centre(2) = 0
+  end type segment_t
+
+  !> An analytic rigid surface. 2D: a chain of segments. 3D: a plane through `point` with
+  !> unit `normal` (bulkflow's *SURFACE, TYPE=PLANE). The material lies on the side the
+  !> normal points to (2D: the left of the direction of travel along the segments, which
+  !> is Abaqus's convention for TYPE=SEGMENTS). The surface translates with ref_node.
+  type, public :: rigid_surface_t
+     character(len=name_length) :: name = ''
+     integer :: ndim = 0
+     integer :: n_segments = 0
+     type(segment_t), allocatable :: segments(:)
+     real(dp) :: point(3) = 0, normal(3) = 0
+     integer :: ref_node = 0              !< internal node index of the *RIGID BODY reference node (0: fixed)
+  end type rigid_surface_t
+end module model_surfaces
