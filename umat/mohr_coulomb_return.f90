@@ -16,8 +16,10 @@
 !>    φ < 0.5°, the clamp only keeps the kernel finite if it is called directly.
 !>  * ψ is clamped to [0, φ]; ψ = 0 is exact (m = 1 exactly, see below).
 !>  * c = 0 is exact (apex at the origin).
-!>  * A relative yield tolerance f ≤ tol·(max|σB| + σc) keeps stress-free and near-zero states
-!>    from flipping regions on round-off.
+!>  * A relative yield tolerance f ≤ tol·(k|σB1| + |σB3| + σc), tol = 1e-12, keeps stress-free
+!>    and near-zero states from flipping regions on round-off. It is measured on the terms of f
+!>    rather than on max|σB| + σc because f itself rounds at eps·k|σ1| (k ≈ 1.3e4 at φ = 89°);
+!>    for φ ≤ 55° the two differ by less than a factor 10.
 !>
 !> ψ = 0: with m = 1 the dilatancy term g_d = λ(m−1) is exactly zero, and every general formula
 !> below reduces *identically* to the closed forms of numerics.md §1.3 (r ∝ (1,0,−1),
@@ -56,7 +58,9 @@ module mohr_coulomb_return
   integer, parameter, public :: cutoff_corner_compression = 5 !< (σt, σt, kσt−σc)
   integer, parameter, public :: cutoff_apex = 6         !< σ = σt(1,1,1)
 
-  !> Relative yield tolerance: f > tol·(max|σB| + σc) is plastic.
+  !> Relative yield tolerance: f > tol·(k|σB1| + |σB3| + σc) is plastic (the size of the terms
+  !> of f; within a factor k of tol·(max|σB| + σc)), σ1 − σt > tol·max(max|σB| + σc, |σt|) for
+  !> the cut-off.
   real(dp), parameter, public :: mc_yield_tolerance = 1.0e-12_dp
   !> sin(0.5°) and sin(89.5°): kernel clamp of the friction angle (Tresca / vertical limits).
   real(dp), parameter, public :: mc_sin_phi_min = 8.7265354983739347e-3_dp
@@ -101,7 +105,7 @@ contains
     real(dp), intent(in) :: sigma_t
     real(dp), intent(out) :: sig(3)
     integer, intent(out) :: region, detail
-    real(dp) :: sp, sq, cos_phi, omk, k, m, sigc, siga, scale, f, tol_f
+    real(dp) :: sp, sq, cos_phi, omk, ik, k, m, sigc, siga, scale, f, tol_f
     real(dp) :: ge, gh, gd, gdk, s1, s2, s3, n1s, n2s, q1s, q2s, t, step
 
     sp = min(max(sin_phi, mc_sin_phi_min), mc_sin_phi_max)
@@ -109,11 +113,14 @@ contains
     cos_phi = sqrt((1.0_dp - sp) * (1.0_dp + sp))
     omk = 1.0_dp / (1.0_dp - sp)
     k = (1.0_dp + sp) * omk
+    ik = (1.0_dp - sp) / (1.0_dp + sp)
     ! σc = 2c√k = 2c·cosφ/(1−sinφ); σa = σc/(k−1) = c·cosφ/sinφ (no k−1 cancellation).
     sigc = 2.0_dp * cohesion * cos_phi * omk
     siga = cohesion * cos_phi / sp
     scale = max(abs(sig_trial(1)), abs(sig_trial(3))) + sigc
-    tol_f = mc_yield_tolerance * scale
+    ! Tolerance on f relative to the size of its terms: evaluating kσ1 − σ3 − σc rounds at
+    ! ~eps·(k|σ1| + |σ3| + σc), which for φ → 89° (k ≈ 1.3e4) is far above eps·scale.
+    tol_f = mc_yield_tolerance * (k * abs(sig_trial(1)) + abs(sig_trial(3)) + sigc)
     detail = cutoff_none
 
     f = k * sig_trial(1) - sig_trial(3) - sigc
@@ -148,27 +155,31 @@ contains
           region = region_apex
        else
           q1s = (gdk + ge) * s1 - (gdk + ge + k * gh) * s2 + gh * s3
+          ! In the three non-apex returns σ1 is finally taken from the plane, σ1 = (σ3 + σc)/k:
+          ! exact in exact arithmetic, and it puts the result on f = 0 to an ulp of σ3 instead
+          ! of k ulps of σB1 (the cancellation σB1 − Δσ1 times k ≈ 1e4 at φ = 89°), so a
+          ! returned stress is found elastic when it is returned again.
           if (q1s < 0.0_dp) then
              t = n1s / (2.0_dp * ge + 2.0_dp * gdk + k * gh)
-             sig(1) = siga + t
-             sig(2) = sig(1)
              sig(3) = siga + k * t
+             sig(1) = (sig(3) + sigc) * ik
+             sig(2) = sig(1)
              region = region_edge_compression
           else
              q2s = k * ge * s1 + (gd - ge - k * (gd + gh)) * s2 + (k * (gd + gh) - gd) * s3
              if (q2s <= 0.0_dp) then
                 step = f / (gdk + k * gh + ge)
-                sig(1) = sig_trial(1) - step * (gd + gh)
                 sig(3) = sig_trial(3) - step * (gd - ge)
+                sig(1) = (sig(3) + sigc) * ik
                 ! The plane return keeps the order inside its region; the clamp only absorbs
                 ! a last-ulp crossing next to the edges.
                 sig(2) = min(max(sig_trial(2) - step * gd, sig(3)), sig(1))
                 region = region_plane
              else
                 t = n2s / (ge + 2.0_dp * gdk + 2.0_dp * k * gh)
-                sig(1) = siga + t
-                sig(2) = siga + k * t
-                sig(3) = sig(2)
+                sig(3) = siga + k * t
+                sig(2) = sig(3)
+                sig(1) = (sig(3) + sigc) * ik
                 region = region_edge_extension
              end if
           end if
@@ -179,7 +190,7 @@ contains
     ! Mohr–Coulomb result still exceeds it. A Mohr–Coulomb KKT point that satisfies σ1 ≤ σt is
     ! also a KKT point of the combined surface, so it is kept.
     if (tension_cutoff) then
-       if (sigma_t < siga .and. sig(1) - sigma_t > tol_f) then
+       if (sigma_t < siga .and. sig(1) - sigma_t > mc_yield_tolerance * max(scale, abs(sigma_t))) then
           ! The scale also covers σt so that it is > 0 whenever this branch is reached.
           call tension_cutoff_return(sig_trial, k, m_of(sq), sigc, sigma_t, lam, shear, &
                max(scale, abs(sigma_t), tiny(1.0_dp)), sig, detail)

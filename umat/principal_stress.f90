@@ -125,17 +125,20 @@ contains
     real(dp), intent(in) :: s(6)
     real(dp), intent(out) :: sig(3)
     real(dp), intent(out) :: vec(3, 3)
-    real(dp) :: amax
+    real(dp) :: amax, sc(6)
     integer :: e
 
+    ! One call site, so that an inlining caller gets one copy of the core; scale() is exact and
+    ! only runs on the rare path.
     amax = max(abs(s(1)), abs(s(2)), abs(s(3)), abs(s(4)), abs(s(5)), abs(s(6)))
-    if (amax > 1.0e-100_dp .and. amax < 1.0e100_dp) then
-       call principal_3d_core(s, sig, vec)
-    else
+    sc = s
+    e = 0
+    if (.not. (amax > 1.0e-100_dp .and. amax < 1.0e100_dp)) then
        e = exponent(amax)
-       call principal_3d_core(scale(s, -e), sig, vec)
-       sig = scale(sig, e)
+       sc = scale(s, -e)
     end if
+    call principal_3d_core(sc, sig, vec)
+    if (e /= 0) sig = scale(sig, e)
   end subroutine principal_3d
 
   !> principal_3d for max|s_ij| in [1e-100, 1e100] (see principal_3d).
