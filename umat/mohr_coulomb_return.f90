@@ -37,7 +37,9 @@
 !> σ1 ≤ σt: the Rankine return alone in closed form (about 25 ns), and only where Mohr–Coulomb is
 !> active as well an active-set solve over the candidate plane sets (numerics.md §1.7).
 module mohr_coulomb_return
+  use, intrinsic :: iso_fortran_env, only: int64
   use material_kinds, only: dp
+  use principal_stress, only: block_points
   implicit none
   private
 
@@ -67,6 +69,7 @@ module mohr_coulomb_return
   real(dp), parameter, public :: mc_sin_phi_max = 0.99996192306417131_dp
 
   public :: mohr_coulomb_principal_return, mohr_coulomb_principal_return_detail
+  public :: mohr_coulomb_return_block
 
   !> Acceptance tolerance (relative to the stress scale) of a candidate active set of the
   !> cut-off solve: looser than the yield tolerance because it absorbs the round-off of a
@@ -198,6 +201,123 @@ contains
        end if
     end if
   end subroutine mohr_coulomb_principal_return_detail
+
+  !> mohr_coulomb_principal_return on n ≤ block_points points, with the same results bit for bit.
+  !> sig_trial(k, :) sorted descending; sin_phi(k), sin_psi(k), cohesion(k) the strength of
+  !> point k; sig(k, :), region(k) as in the scalar routine. Arrays of two dimensions have
+  !> block_points rows (see principal_stress).
+  !>
+  !> One loop over the points without any branch, vectorised by gfortran -O3: every point
+  !> evaluates the three closed forms (edge σ1=σ2, plane, edge σ2=σ3) with the scalar routine's
+  !> operations, and the result of its region (or the trial state, or the apex) is selected
+  !> bitwise (sign_mask, bit_select; see principal_stress): with merge() the optimiser turns the
+  !> selections back into branches and moves each closed form into its own branch, and a loop
+  !> with floating-point operations under a branch is not vectorised (-ftrapping-math). All divisors are positive for λ > −2G/3 (positive bulk
+  !> modulus), so the closed forms that are not selected cannot trap either.
+  !> The tension cut-off is a second pass: where the Mohr–Coulomb result exceeds σt, the point
+  !> is returned again by the scalar routine (which applies the cut-off exactly as there).
+  pure subroutine mohr_coulomb_return_block(n, sig_trial, sin_phi, sin_psi, cohesion, lam, &
+       shear, tension_cutoff, sigma_t, sig, region)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: sig_trial(block_points, 3)
+    real(dp), intent(in) :: sin_phi(n), sin_psi(n), cohesion(n)
+    real(dp), intent(in) :: lam, shear
+    logical, intent(in) :: tension_cutoff
+    real(dp), intent(in) :: sigma_t
+    real(dp), intent(out) :: sig(block_points, 3)
+    integer, intent(out) :: region(n)
+    real(dp) :: sp, sq, cos_phi, omk, ik, k, m, sigc, siga, f, tol_f
+    real(dp) :: ge, gh, gd, gdk, st1, st2, st3, s1, s2, s3, n1s, n2s, q1s, q2s
+    real(dp) :: t, step, c1, c3, p1, p2, p3, e1, e3, r1, r2, r3
+    integer(int64) :: plastic, apex, edge1, plane, extension
+    real(dp) :: trial(3), sig3(3)
+    integer :: i
+
+    do i = 1, n
+       sp = min(max(sin_phi(i), mc_sin_phi_min), mc_sin_phi_max)
+       sq = min(max(sin_psi(i), 0.0_dp), sp)
+       cos_phi = sqrt((1.0_dp - sp) * (1.0_dp + sp))
+       omk = 1.0_dp / (1.0_dp - sp)
+       k = (1.0_dp + sp) * omk
+       ik = (1.0_dp - sp) / (1.0_dp + sp)
+       sigc = 2.0_dp * cohesion(i) * cos_phi * omk
+       siga = cohesion(i) * cos_phi / sp
+       st1 = sig_trial(i, 1)
+       st2 = sig_trial(i, 2)
+       st3 = sig_trial(i, 3)
+       tol_f = mc_yield_tolerance * (k * abs(st1) + abs(st3) + sigc)
+       f = k * st1 - st3 - sigc
+
+       m = (1.0_dp + sq) / (1.0_dp - sq)
+       ge = 2.0_dp * shear
+       gh = ge * m
+       gd = lam * (m - 1.0_dp)
+       gdk = gd * (k - 1.0_dp)
+       s1 = st1 - siga
+       s2 = st2 - siga
+       s3 = st3 - siga
+       n1s = (ge - gd) * (s1 + s2) + (2.0_dp * gd + gh) * s3
+       n2s = (ge - 2.0_dp * gd) * s1 + (gd + gh) * (s2 + s3)
+       q1s = (gdk + ge) * s1 - (gdk + ge + k * gh) * s2 + gh * s3
+       q2s = k * ge * s1 + (gd - ge - k * (gd + gh)) * s2 + (k * (gd + gh) - gd) * s3
+
+       ! The scalar routine's tests, exactly (a − b ≥ 0 ⇔ a ≥ b; 0 − x < 0 ⇔ x > 0;
+       ! x + 0 < 0 ⇔ x < 0, −0 included):
+       plastic = sign_mask(tol_f - f)                                  ! f > tol_f
+       apex = iand(sign_mask(0.0_dp - n1s), sign_mask(0.0_dp - n2s))   ! n1s > 0, n2s > 0
+       edge1 = sign_mask(q1s + 0.0_dp)                                 ! q1s < 0
+       plane = iand(not(edge1), not(sign_mask(0.0_dp - q2s)))          ! q1s ≥ 0, q2s ≤ 0
+       extension = iand(not(edge1), not(plane))
+
+       ! The three closed forms, each with the scalar routine's operations.
+       t = n1s / (2.0_dp * ge + 2.0_dp * gdk + k * gh)
+       c3 = siga + k * t
+       c1 = (c3 + sigc) * ik
+       step = f / (gdk + k * gh + ge)
+       p3 = st3 - step * (gd - ge)
+       p1 = (p3 + sigc) * ik
+       p2 = min(max(st2 - step * gd, p3), p1)
+       t = n2s / (ge + 2.0_dp * gdk + 2.0_dp * k * gh)
+       e3 = siga + k * t
+       e1 = (e3 + sigc) * ik
+
+       r1 = bit_select(edge1, c1, bit_select(plane, p1, e1))
+       r2 = bit_select(edge1, c1, bit_select(plane, p2, e3))
+       r3 = bit_select(edge1, c3, bit_select(plane, p3, e3))
+       sig(i, 1) = bit_select(plastic, bit_select(apex, siga, r1), st1)
+       sig(i, 2) = bit_select(plastic, bit_select(apex, siga, r2), st2)
+       sig(i, 3) = bit_select(plastic, bit_select(apex, siga, r3), st3)
+       region(i) = int(iand(plastic, ior(iand(apex, int(region_apex, int64)), iand(not(apex), &
+            ior(ior(iand(edge1, int(region_edge_compression, int64)), &
+            iand(plane, int(region_plane, int64))), &
+            iand(extension, int(region_edge_extension, int64)))))))
+    end do
+
+    ! Rankine cut-off: a result above σt is a candidate (the scalar routine decides).
+    if (.not. tension_cutoff) return
+    do i = 1, n
+       if (.not. sig(i, 1) > sigma_t) cycle
+       trial = sig_trial(i, :)
+       call mohr_coulomb_principal_return(trial, sin_phi(i), sin_psi(i), cohesion(i), lam, &
+            shear, tension_cutoff, sigma_t, sig3, region(i))
+       sig(i, :) = sig3
+    end do
+  end subroutine mohr_coulomb_return_block
+
+  !> All ones where x has its sign bit set, zeros elsewhere (see principal_stress). A private
+  !> copy, so that it is inlined into the block loop without link-time optimisation.
+  elemental integer(int64) function sign_mask(x)
+    real(dp), intent(in) :: x
+    sign_mask = -ishft(transfer(x, 0_int64), -63)
+  end function sign_mask
+
+  !> a where mask is all ones, b where it is zero (see principal_stress; private copy).
+  elemental real(dp) function bit_select(mask, a, b)
+    integer(int64), intent(in) :: mask
+    real(dp), intent(in) :: a, b
+    bit_select = transfer(ior(iand(transfer(a, 0_int64), mask), iand(transfer(b, 0_int64), &
+         not(mask))), a)
+  end function bit_select
 
   pure real(dp) function m_of(sin_psi)
     real(dp), intent(in) :: sin_psi

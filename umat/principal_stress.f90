@@ -20,11 +20,19 @@
 !> Cost (gfortran 12 -O3, not inlined, one AMD EPYC core): principal_plane ≈ 10 ns,
 !> principal_3d ≈ 95 ns; the 3D time is the latency of its sqrt/div chain.
 module principal_stress
+  use, intrinsic :: iso_fortran_env, only: int64
   use material_kinds, only: dp
   implicit none
   private
 
   public :: principal_plane, rebuild_plane, principal_3d, rebuild_3d
+  public :: principal_plane_block, rebuild_plane_block, principal_3d_block, rebuild_3d_block
+
+  !> Rows of the work arrays of the block routines: they take n ≤ block_points points in
+  !> arrays dimensioned (block_points, ...). A constant leading dimension lets the compiler see
+  !> that the columns never overlap; with a run-time one it would need more alias checks than
+  !> it allows and would not vectorise. 64 points keep a chunk's work arrays in L1.
+  integer, parameter, public :: block_points = 64
 
   !> Absolute floor of the deviator size p in principal_3d_core: below it the tensor is treated
   !> as isotropic, which keeps 1/p finite (inputs there are pre-scaled to max|s_ij| ≥ 1e-100, so
@@ -277,7 +285,6 @@ contains
     real(dp) :: mid, d, o, amax, rho, rs, t, inv
     integer :: e
     logical :: pos
-
     mid = 0.5_dp * (a11 + a22)
     d = 0.5_dp * (a11 - a22)
     o = a12
@@ -303,6 +310,322 @@ contains
     c = merge(t, o, pos) * inv
     sn = merge(o, t, pos) * inv
   end subroutine sym2_eigen
+
+  ! ---------------------------------------------------------------------------------------------
+  ! Block versions: the same algorithms on n points at once, in the layout of the VUMAT arrays
+  ! (point index first, unit stride), with the same results bit for bit (same operations in the
+  ! same order; no FMA: -ffp-contract=off). Each routine is one loop over the points without
+  ! any branch, so that gfortran -O3 vectorises it across points:
+  !  * selections are bitwise (sign_mask, bit_select): the sign bit of a difference decides,
+  !    and integer masks pick the bits. merge() would also be branch-free in the source, but
+  !    the optimiser turns merges back into branches and moves the arithmetic that follows
+  !    them into those branches; under the default -ftrapping-math a floating-point operation
+  !    under a branch stops the vectoriser. (merge() of values that are only stored is safe.)
+  !  * every point evaluates every case (the special cases too), so the operands of sqrt and of
+  !    the divisions are guarded (a floor, or a substitute value for the case that is not
+  !    taken) and no lane, used or not, can trap in the debug build.
+  ! Two-dimensional arrays have block_points rows, of which the first n ≤ block_points are used,
+  ! so that a caller keeps fixed-size work arrays and passes a shorter last chunk without a copy.
+  ! The only results that may differ from the scalar routines, in the last bits, are those of
+  ! tensors whose size is outside [1e-100, 1e100] (3D) or whose in-plane deviator is outside
+  ! [1e-150, 1e150]: the block routines scale them by fixed powers of two instead of exponent-
+  ! dependent ones.
+  ! ---------------------------------------------------------------------------------------------
+
+  !> principal_plane on n points: s(k, 1:4) = (11, 22, 33, 12) of point k; sig(k, :) sorted
+  !> descending, (c(k), sn(k)) the in-plane angle, izz(k) the slot of s33 (see principal_plane).
+  pure subroutine principal_plane_block(n, s, sig, c, sn, izz)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: s(block_points, 4)
+    real(dp), intent(out) :: sig(block_points, 3)
+    real(dp), intent(out) :: c(n), sn(n)
+    integer, intent(out) :: izz(n)
+    real(dp) :: sa, sb, szz, cs, ss
+    integer(int64) :: above_a, above_b
+    integer :: k
+
+    do k = 1, n
+       call sym2_eigen_vec(s(k, 1), s(k, 2), s(k, 4), sa, sb, cs, ss)
+       c(k) = cs
+       sn(k) = ss
+       szz = s(k, 3)
+       ! szz ≥ sa, szz ≥ sb (the second follows from the first, sa ≥ sb).
+       above_a = not(sign_mask(szz - sa))
+       above_b = not(sign_mask(szz - sb))
+       sig(k, 1) = bit_select(above_a, szz, sa)
+       sig(k, 2) = bit_select(above_a, sa, bit_select(above_b, szz, sb))
+       sig(k, 3) = bit_select(above_b, sb, szz)
+       ! 1, 2 or 3 (the masks are −1 or 0).
+       izz(k) = int(3_int64 + above_a + above_b)
+    end do
+  end subroutine principal_plane_block
+
+  !> rebuild_plane on n points (any three values per point in the stored basis).
+  pure subroutine rebuild_plane_block(n, sig, c, sn, izz, s)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: sig(block_points, 3)
+    real(dp), intent(in) :: c(n), sn(n)
+    integer, intent(in) :: izz(n)
+    real(dp), intent(out) :: s(block_points, 4)
+    real(dp) :: s1, s2, s3, sa, sb, szz, cc, ss
+    integer :: k
+
+    do k = 1, n
+       ! Unconditional loads, then selections of the loaded values only.
+       s1 = sig(k, 1)
+       s2 = sig(k, 2)
+       s3 = sig(k, 3)
+       szz = merge(s1, merge(s2, s3, izz(k) == 2), izz(k) == 1)
+       sa = merge(s2, s1, izz(k) == 1)
+       sb = merge(s2, s3, izz(k) == 3)
+       cc = c(k) * c(k)
+       ss = sn(k) * sn(k)
+       s(k, 1) = sa * cc + sb * ss
+       s(k, 2) = sa * ss + sb * cc
+       s(k, 3) = szz
+       s(k, 4) = (sa - sb) * c(k) * sn(k)
+    end do
+  end subroutine rebuild_plane_block
+
+  !> principal_3d on n points: s(k, 1:6) = (11,22,33,12,23,31) of point k; sig(k, :) sorted
+  !> descending; vec(k, :, i) the unit eigenvector of sig(k, i). The method and the results
+  !> are those of principal_3d (see principal_3d_core); its special cases become:
+  !>  * size: max|s_ij| outside [1e-100, 1e100] is scaled by a fixed power of two (2^704
+  !>    below, 2^-678 above) into [1e-112, 1e112], where no square under- or overflows, and
+  !>    the values scaled back at the end; sizes inside are scaled by 2, which is exact and
+  !>    changes no result bit (it keeps 1.0 out of the selection);
+  !>  * isotropic tensors: C = 0 meanwhile (finite throughout), then sig = q and the identity;
+  !>  * the (unreachable) tiny cross product: x = (1, 0, 0), as in principal_3d_core.
+  pure subroutine principal_3d_block(n, s, sig, vec)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: s(block_points, 6)
+    real(dp), intent(out) :: sig(block_points, 3)
+    real(dp), intent(out) :: vec(block_points, 3, 3)
+    ! Degree-8 fit of 2cos(acos(ρ)/3) on [0, 1] (as in principal_3d_core).
+    real(dp), parameter :: f0 = 1.7320508160829569_dp, f1 = 0.33333253539506985_dp
+    real(dp), parameter :: f2 = -0.09620655020681854_dp, f3 = 0.04919767526830958_dp
+    real(dp), parameter :: f4 = -0.030190554045480565_dp, f5 = 0.01874415728341634_dp
+    real(dp), parameter :: f6 = -0.009859042862492647_dp, f7 = 0.0035427520895337217_dp
+    real(dp), parameter :: f8 = -0.0006117952499170653_dp
+    real(dp), parameter :: third = 1.0_dp / 3.0_dp
+    real(dp), parameter :: scale_up = 2.0_dp**704, scale_down = 2.0_dp**(-678)
+    real(dp) :: s1, s2, s3, s4, s5, s6, amax, sf, isf, q, b11, b22, b33, p2, p, ip
+    real(dp) :: c11, c22, c33, c12, c23, c13, r, rho, rho2, rho4, mu, mm
+    real(dp) :: x01_1, x01_2, x01_3, x02_1, x02_2, x02_3, x12_1, x12_2, x12_3, n01, n02, n12
+    real(dp) :: x1, x2, x3, nx, u1, u2, u3, w1, w2, w3, v1, v2, v3, inv_x, inv_u
+    real(dp) :: cu1, cu2, cu3, cw1, cw2, cw3, a11, a22, a12, mu_a, mu_b, cs, sn, mu_s
+    real(dp) :: ea1, ea2, ea3, eb1, eb2, eb3
+    integer(int64) :: small, large, iso, top, pick01, pick02, big, first
+    integer :: k
+
+    do k = 1, n
+       amax = max(abs(s(k, 1)), abs(s(k, 2)), abs(s(k, 3)), abs(s(k, 4)), abs(s(k, 5)), &
+            abs(s(k, 6)))
+       small = not(sign_mask(1.0e-100_dp - amax))     ! amax ≤ 1e-100
+       large = not(sign_mask(amax - 1.0e100_dp))      ! amax ≥ 1e100
+       sf = bit_select(small, scale_up, bit_select(large, scale_down, 2.0_dp))
+       isf = bit_select(small, 1.0_dp / scale_up, bit_select(large, 1.0_dp / scale_down, 0.5_dp))
+       s1 = s(k, 1) * sf
+       s2 = s(k, 2) * sf
+       s3 = s(k, 3) * sf
+       s4 = s(k, 4) * sf
+       s5 = s(k, 5) * sf
+       s6 = s(k, 6) * sf
+
+       q = (s1 + s2 + s3) * third
+       b11 = s1 - q
+       b22 = s2 - q
+       b33 = s3 - q
+       p2 = (b11 * b11 + b22 * b22 + b33 * b33 &
+            + 2.0_dp * (s4 * s4 + s5 * s5 + s6 * s6)) * (1.0_dp / 6.0_dp)
+       iso = not(sign_mask(max(radius_floor**2, (4.0_dp * epsilon(1.0_dp) * q)**2) - p2))
+       p = sqrt(p2)
+       ip = bit_select(iso, 0.0_dp, 1.0_dp / max(p, radius_floor))
+       c11 = b11 * ip
+       c22 = b22 * ip
+       c33 = b33 * ip
+       c12 = s4 * ip
+       c23 = s5 * ip
+       c13 = s6 * ip
+
+       r = 0.5_dp * (c11 * (c22 * c33 - c23 * c23) - c12 * (c12 * c33 - c23 * c13) &
+            + c13 * (c12 * c23 - c22 * c13))
+       rho = min(abs(r), 1.0_dp)
+       rho2 = rho * rho
+       rho4 = rho2 * rho2
+       mu = ((f0 + f1 * rho) + (f2 + f3 * rho) * rho2) &
+            + ((f4 + f5 * rho) + (f6 + f7 * rho) * rho2) * rho4 + f8 * (rho4 * rho4)
+       mm = mu * mu
+       mu = mu - (mu * (mm - 3.0_dp) - 2.0_dp * rho) / (3.0_dp * (mm - 1.0_dp))
+       top = not(sign_mask(r + 0.0_dp))               ! r ≥ 0 (−0 included)
+       mu = bit_select(top, mu, -mu)
+
+       ! Cross products of the rows of C − μI; the largest is the separated eigenvector.
+       x01_1 = c12 * c23 - c13 * (c22 - mu)
+       x01_2 = c13 * c12 - (c11 - mu) * c23
+       x01_3 = (c11 - mu) * (c22 - mu) - c12 * c12
+       x02_1 = c12 * (c33 - mu) - c13 * c23
+       x02_2 = c13 * c13 - (c11 - mu) * (c33 - mu)
+       x02_3 = (c11 - mu) * c23 - c12 * c13
+       x12_1 = (c22 - mu) * (c33 - mu) - c23 * c23
+       x12_2 = c23 * c13 - c12 * (c33 - mu)
+       x12_3 = c12 * c23 - (c22 - mu) * c13
+       n01 = x01_1 * x01_1 + x01_2 * x01_2 + x01_3 * x01_3
+       n02 = x02_1 * x02_1 + x02_2 * x02_2 + x02_3 * x02_3
+       n12 = x12_1 * x12_1 + x12_2 * x12_2 + x12_3 * x12_3
+       pick01 = not(sign_mask(n01 - max(n02, n12)))   ! n01 ≥ max(n02, n12)
+       pick02 = not(sign_mask(n02 - n12))             ! n02 ≥ n12
+       x1 = bit_select(pick01, x01_1, bit_select(pick02, x02_1, x12_1))
+       x2 = bit_select(pick01, x01_2, bit_select(pick02, x02_2, x12_2))
+       x3 = bit_select(pick01, x01_3, bit_select(pick02, x02_3, x12_3))
+       nx = max(n01, n02, n12)
+       ! Unreachable for finite input (nx ≥ 3 in exact arithmetic), as in principal_3d_core.
+       big = sign_mask(1.0e-6_dp - nx)                ! nx > 1e-6
+       x1 = bit_select(big, x1, 1.0_dp)
+       x2 = bit_select(big, x2, 0.0_dp)
+       x3 = bit_select(big, x3, 0.0_dp)
+       nx = bit_select(big, nx, 1.0_dp)
+
+       ! Orthonormal triad (v, u, w) as in principal_3d_core: u = (−x3, 0, x1) if
+       ! |x1| > |x2|, else (0, x3, −x2).
+       first = sign_mask(abs(x2) - abs(x1))           ! |x1| > |x2|
+       u1 = bit_select(first, -x3, 0.0_dp)
+       u2 = bit_select(first, 0.0_dp, x3)
+       u3 = bit_select(first, x1, -x2)
+       w1 = x2 * u3 - x3 * u2
+       w2 = x3 * u1 - x1 * u3
+       w3 = x1 * u2 - x2 * u1
+       inv_x = 1.0_dp / sqrt(nx)
+       inv_u = 1.0_dp / sqrt(u1 * u1 + u2 * u2 + u3 * u3)
+       v1 = x1 * inv_x
+       v2 = x2 * inv_x
+       v3 = x3 * inv_x
+       w1 = w1 * (inv_x * inv_u)
+       w2 = w2 * (inv_x * inv_u)
+       w3 = w3 * (inv_x * inv_u)
+       u1 = u1 * inv_u
+       u2 = u2 * inv_u
+       u3 = u3 * inv_u
+
+       ! Exact projection of C on (u, w); the separated value from the trace.
+       cu1 = c11 * u1 + c12 * u2 + c13 * u3
+       cu2 = c12 * u1 + c22 * u2 + c23 * u3
+       cu3 = c13 * u1 + c23 * u2 + c33 * u3
+       cw1 = c11 * w1 + c12 * w2 + c13 * w3
+       cw2 = c12 * w1 + c22 * w2 + c23 * w3
+       cw3 = c13 * w1 + c23 * w2 + c33 * w3
+       a11 = u1 * cu1 + u2 * cu2 + u3 * cu3
+       a22 = w1 * cw1 + w2 * cw2 + w3 * cw3
+       a12 = u1 * cw1 + u2 * cw2 + u3 * cw3
+       mu_s = (c11 + c22 + c33) - a11 - a22
+       call sym2_eigen_vec(a11, a22, a12, mu_a, mu_b, cs, sn)
+       ea1 = cs * u1 + sn * w1
+       ea2 = cs * u2 + sn * w2
+       ea3 = cs * u3 + sn * w3
+       eb1 = cs * w1 - sn * u1
+       eb2 = cs * w2 - sn * u2
+       eb3 = cs * w3 - sn * u3
+
+       ! The separated root is the largest (r ≥ 0) or the smallest (r < 0); isotropic: q
+       ! (p = 0) and the identity.
+       p = bit_select(iso, 0.0_dp, p)
+       mu_s = (q + p * mu_s) * isf
+       mu_a = (q + p * mu_a) * isf
+       mu_b = (q + p * mu_b) * isf
+       sig(k, 1) = bit_select(top, mu_s, mu_a)
+       sig(k, 2) = bit_select(top, mu_a, mu_b)
+       sig(k, 3) = bit_select(top, mu_b, mu_s)
+       vec(k, 1, 1) = bit_select(iso, 1.0_dp, bit_select(top, v1, ea1))
+       vec(k, 2, 1) = bit_select(iso, 0.0_dp, bit_select(top, v2, ea2))
+       vec(k, 3, 1) = bit_select(iso, 0.0_dp, bit_select(top, v3, ea3))
+       vec(k, 1, 2) = bit_select(iso, 0.0_dp, bit_select(top, ea1, eb1))
+       vec(k, 2, 2) = bit_select(iso, 1.0_dp, bit_select(top, ea2, eb2))
+       vec(k, 3, 2) = bit_select(iso, 0.0_dp, bit_select(top, ea3, eb3))
+       vec(k, 1, 3) = bit_select(iso, 0.0_dp, bit_select(top, eb1, v1))
+       vec(k, 2, 3) = bit_select(iso, 0.0_dp, bit_select(top, eb2, v2))
+       vec(k, 3, 3) = bit_select(iso, 1.0_dp, bit_select(top, eb3, v3))
+    end do
+  end subroutine principal_3d_block
+
+  !> rebuild_3d on n points (any three values per point in the basis vec(k, :, :)).
+  pure subroutine rebuild_3d_block(n, sig, vec, s)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: sig(block_points, 3)
+    real(dp), intent(in) :: vec(block_points, 3, 3)
+    real(dp), intent(out) :: s(block_points, 6)
+    real(dp) :: a1, a2, a3, b1, b2, b3, c1, c2, c3
+    integer :: k
+
+    do k = 1, n
+       a1 = sig(k, 1) * vec(k, 1, 1)
+       a2 = sig(k, 1) * vec(k, 2, 1)
+       a3 = sig(k, 1) * vec(k, 3, 1)
+       b1 = sig(k, 2) * vec(k, 1, 2)
+       b2 = sig(k, 2) * vec(k, 2, 2)
+       b3 = sig(k, 2) * vec(k, 3, 2)
+       c1 = sig(k, 3) * vec(k, 1, 3)
+       c2 = sig(k, 3) * vec(k, 2, 3)
+       c3 = sig(k, 3) * vec(k, 3, 3)
+       s(k, 1) = a1 * vec(k, 1, 1) + b1 * vec(k, 1, 2) + c1 * vec(k, 1, 3)
+       s(k, 2) = a2 * vec(k, 2, 1) + b2 * vec(k, 2, 2) + c2 * vec(k, 2, 3)
+       s(k, 3) = a3 * vec(k, 3, 1) + b3 * vec(k, 3, 2) + c3 * vec(k, 3, 3)
+       s(k, 4) = a1 * vec(k, 2, 1) + b1 * vec(k, 2, 2) + c1 * vec(k, 2, 3)
+       s(k, 5) = a2 * vec(k, 3, 1) + b2 * vec(k, 3, 2) + c2 * vec(k, 3, 3)
+       s(k, 6) = a3 * vec(k, 1, 1) + b3 * vec(k, 1, 2) + c3 * vec(k, 1, 3)
+    end do
+  end subroutine rebuild_3d_block
+
+  !> sym2_eigen for the block loops: the same operations, no branch. Deviators outside
+  !> [1e-150, 1e150] are scaled by 2^600 or 2^-600 (into [1e-143, 1e128]) instead of an
+  !> exponent-dependent power of two, the others by 2 (exact: no result bit changes); a double
+  !> root (d = a12 = 0) keeps the current axes.
+  pure subroutine sym2_eigen_vec(a11, a22, a12, mu_a, mu_b, c, sn)
+    real(dp), intent(in) :: a11, a22, a12
+    real(dp), intent(out) :: mu_a, mu_b, c, sn
+    real(dp), parameter :: up = 2.0_dp**600, down = 2.0_dp**(-600)
+    !> Below every non-zero t (≥ 2e-143 after scaling); its square is a normal number, and a
+    !> power of two gives c = 1, sn = 0 exactly for a double root.
+    real(dp), parameter :: t_floor = 2.0_dp**(-504)
+    real(dp) :: mid, d, o, amax, f, g, rs, rho, t, inv
+    integer(int64) :: small, large, pos
+
+    mid = 0.5_dp * (a11 + a22)
+    d = 0.5_dp * (a11 - a22)
+    amax = max(abs(d), abs(a12))
+    small = not(sign_mask(1.0e-150_dp - amax))    ! amax ≤ 1e-150
+    large = not(sign_mask(amax - 1.0e150_dp))     ! amax ≥ 1e150
+    f = bit_select(small, up, bit_select(large, down, 2.0_dp))
+    g = bit_select(small, down, bit_select(large, up, 0.5_dp))
+    t = abs(d) * f
+    o = a12 * f
+    rs = sqrt(t * t + o * o)
+    rho = rs * g
+    t = max(t + rs, t_floor)
+    mu_a = mid + rho
+    mu_b = mid - rho
+    inv = 1.0_dp / sqrt(t * t + o * o)
+    t = t * inv
+    o = o * inv
+    pos = not(sign_mask(d + 0.0_dp))              ! d ≥ 0 (−0 included)
+    c = bit_select(pos, t, o)
+    sn = bit_select(pos, o, t)
+  end subroutine sym2_eigen_vec
+
+  !> All ones where x has its sign bit set (x < 0 or x = −0), zeros elsewhere: with a
+  !> difference a − b, which is +0 for a = b, it turns a comparison into a bit mask
+  !> (a < b ⇔ sign_mask(a − b) set; a ≥ b ⇔ clear).
+  elemental integer(int64) function sign_mask(x)
+    real(dp), intent(in) :: x
+    sign_mask = -ishft(transfer(x, 0_int64), -63)
+  end function sign_mask
+
+  !> a where mask is all ones, b where it is zero: a bitwise selection, exact and branch-free.
+  elemental real(dp) function bit_select(mask, a, b)
+    integer(int64), intent(in) :: mask
+    real(dp), intent(in) :: a, b
+    bit_select = transfer(ior(iand(transfer(a, 0_int64), mask), iand(transfer(b, 0_int64), &
+         not(mask))), a)
+  end function bit_select
 
   pure function cross(a1, a2, a3, b1, b2, b3) result(x)
     real(dp), intent(in) :: a1, a2, a3, b1, b2, b3

@@ -20,10 +20,15 @@ module model_materials
      character(len=256) :: source = ''           !< file:line of *MATERIAL, for messages
   end type material_t
 
-  !> *SOLID SECTION, ELSET=..., MATERIAL=... (data line: thickness for plane strain, default 1).
+  !> *SOLID SECTION, ELSET=..., MATERIAL=... (data line: thickness for plane strain, default 1),
+  !> with its hourglass control.
   type, public :: section_t
      character(len=name_length) :: elset = ''
      integer :: material = 0                     !< index into model%materials
      real(dp) :: thickness = 1
+     !> Hourglass control (*SECTION CONTROLS, HOURGLASS=VISCOUS|STIFFNESS, HOURGLASS SCALING):
+     !> 1 viscous, 2 stiffness (the fem_hourglass codes); coefficient 0 means the default.
+     integer :: hourglass = 1
+     real(dp) :: hourglass_coefficient = 0
   end type section_t
 end module model_materials

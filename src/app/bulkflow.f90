@@ -1,0 +1,116 @@
+!> bulkflow: explicit dynamics of bulk solids from an Abaqus-syntax scene.
+!>
+!>   mpirun -np N bulkflow scene.inp [--check] [--output BASE] [--restart] [--stop-after N]
+!>                                   [--quiet]
+!>
+!> The scene is read and checked completely before the first increment; any problem stops with
+!> `file:line: message` and exit status 2. Outputs: BASE.h5 + BASE.xmf (field frames),
+!> BASE_history.csv (energies, wall forces, node-set values), BASE.rst.<rank> (checkpoints).
+!> BASE defaults to the scene's file name without its extension, in the working directory.
+program bulkflow
+  use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+  use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Abort, MPI_COMM_WORLD, MPI_Comm_rank, MPI_Comm_size
+  use error_report, only: error_t, fatal_error, set_final_stop
+  use model, only: model_t
+  use scene_reader, only: read_scene
+  use driver_run, only: run_options_t, run_scene
+  use abaqus_host, only: host_set_exit_handler
+  implicit none
+  type(model_t) :: m
+  type(error_t) :: err
+  type(run_options_t) :: opts
+  character(len=:), allocatable :: scene
+  logical :: check_only
+  integer :: rank, nranks
+
+  call MPI_Init()
+  call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+  call MPI_Comm_size(MPI_COMM_WORLD, nranks)
+  ! With several ranks an error on one must end them all.
+  if (nranks > 1) then
+     call set_final_stop(abort_all)
+     call host_set_exit_handler(abort_all_status)
+  end if
+  call parse_arguments(scene, opts, check_only)
+
+  call read_scene(scene, m, err)
+  if (err%raised) call fatal_error(err)
+  if (check_only) then
+     if (rank == 0) write (output_unit, '(a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (', &
+          m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, ' elements, ', m%n_steps, ' steps)'
+  else
+     call run_scene(m, MPI_COMM_WORLD, opts)
+  end if
+  call MPI_Finalize()
+
+contains
+
+  subroutine parse_arguments(scene, opts, check_only)
+    character(len=:), allocatable, intent(out) :: scene
+    type(run_options_t), intent(inout) :: opts
+    logical, intent(out) :: check_only
+    character(len=1024) :: arg, value
+    integer :: i, n, ios, dot, slash
+
+    check_only = .false.
+    n = command_argument_count()
+    i = 1
+    scene = ''
+    do while (i <= n)
+       call get_command_argument(i, arg)
+       select case (trim(arg))
+       case ('--check')
+          check_only = .true.
+       case ('--restart')
+          opts%restart = .true.
+       case ('--quiet')
+          opts%progress = .false.
+       case ('--output', '--stop-after')
+          if (i == n) call usage('option ' // trim(arg) // ' needs a value')
+          call get_command_argument(i + 1, value)
+          if (trim(arg) == '--output') then
+             opts%output_base = trim(value)
+          else
+             read (value, *, iostat=ios) opts%stop_after
+             if (ios /= 0 .or. opts%stop_after < 1) call usage('--stop-after needs a positive increment number')
+          end if
+          i = i + 1
+       case ('-h', '--help')
+          call usage('')
+       case default
+          if (arg(1:1) == '-') call usage('unknown option ' // trim(arg))
+          if (len(scene) > 0) call usage('one scene file only')
+          scene = trim(arg)
+       end select
+       i = i + 1
+    end do
+    if (len(scene) == 0) call usage('no scene file given')
+    if (.not. allocated(opts%output_base)) then
+       slash = index(scene, '/', back=.true.)
+       dot = index(scene, '.', back=.true.)
+       if (dot <= slash) dot = len(scene) + 1
+       opts%output_base = scene(slash + 1:dot - 1)
+    end if
+  end subroutine parse_arguments
+
+  subroutine usage(problem)
+    character(len=*), intent(in) :: problem
+    if (rank == 0) then
+       if (len(problem) > 0) write (error_unit, '(a)') 'bulkflow: error: ' // problem
+       write (error_unit, '(a)') 'usage: [mpirun -np N] bulkflow scene.inp [--check] [--output BASE] ' // &
+            '[--restart] [--stop-after N] [--quiet]'
+    end if
+    call MPI_Finalize()
+    if (len(problem) > 0) error stop 2
+    stop
+  end subroutine usage
+
+  subroutine abort_all()
+    call MPI_Abort(MPI_COMM_WORLD, 2)
+  end subroutine abort_all
+
+  subroutine abort_all_status(status)
+    integer, intent(in) :: status
+    call MPI_Abort(MPI_COMM_WORLD, status)
+  end subroutine abort_all_status
+end program bulkflow

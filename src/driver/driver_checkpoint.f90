@@ -1,0 +1,144 @@
+!> Checkpoint and restart of the solver state: everything that changes during a run and is not
+!> rebuilt identically from the model by the set-up (nodal motion, element state, rigid bodies,
+!> energies, time, output counters). A restarted run continues bit for bit as the uninterrupted
+!> one would have. One file per rank (output_checkpoint), so a restart needs the same number of
+!> ranks.
+module driver_checkpoint
+  use material_kinds, only: dp
+  use output_checkpoint, only: checkpoint_t, checkpoint_header_t, checkpoint_begin_write, checkpoint_put, &
+       checkpoint_end_write, checkpoint_begin_read, checkpoint_get, checkpoint_end_read
+  use output_hdf5, only: field_writer_frame_count
+  use output_history, only: history_row_count
+  use driver_solver, only: solver_t
+  use driver_output, only: run_output_t
+  implicit none
+  private
+
+  public :: save_checkpoint, load_checkpoint
+
+contains
+
+  subroutine save_checkpoint(base, solver, out)
+    character(len=*), intent(in) :: base
+    type(solver_t), intent(in) :: solver
+    type(run_output_t), intent(in) :: out
+    type(checkpoint_t) :: ck
+    type(checkpoint_header_t) :: header
+    integer :: ib
+    character(len=16) :: tag
+
+    header%step = solver%step
+    header%increment = solver%increment
+    header%step_time = solver%step_time
+    header%total_time = solver%total_time
+    header%dt = solver%dt
+    header%frame_count = 0
+    if (out%fields_open) header%frame_count = field_writer_frame_count(out%fields)
+    header%history_rows = history_row_count(out%history)
+    call checkpoint_begin_write(ck, base, solver%part%comm, header)
+    call checkpoint_put(ck, 'u', solver%u)
+    call checkpoint_put(ck, 'v', solver%v)
+    call checkpoint_put(ck, 'a', solver%a)
+    call checkpoint_put(ck, 'f_int', solver%f_int)
+    call checkpoint_put(ck, 'f_ext', solver%f_ext)
+    call checkpoint_put(ck, 'reaction', solver%reaction)
+    call checkpoint_put(ck, 'rigid_u', rigid_array(solver, .true.))
+    call checkpoint_put(ck, 'rigid_v', rigid_array(solver, .false.))
+    call checkpoint_put(ck, 'scalars', [solver%e_viscous, solver%e_artificial, solver%e_friction, &
+         solver%e_external, solver%step_start, solver%dt_prev, solver%dt_stable, out%next_field, &
+         out%next_history, out%energy_reference])
+    call checkpoint_put(ck, 'counters', [solver%step_increment, solver%dt_element])
+    do ib = 1, solver%n_blocks
+       write (tag, '(a,i0,a)') 'b', ib, '_'
+       associate (b => solver%blocks(ib))
+         call checkpoint_put(ck, trim(tag) // 'rotation', b%rotation)
+         call checkpoint_put(ck, trim(tag) // 'hourglass', b%hourglass)
+         call checkpoint_put(ck, trim(tag) // 'stress', b%stress)
+         call checkpoint_put(ck, trim(tag) // 'stress_global', b%stress_global)
+         call checkpoint_put(ck, trim(tag) // 'state', b%state)
+         call checkpoint_put(ck, trim(tag) // 'field', b%field)
+         call checkpoint_put(ck, trim(tag) // 'e_int', b%e_int)
+         call checkpoint_put(ck, trim(tag) // 'e_inel', b%e_inel)
+         call checkpoint_put(ck, trim(tag) // 'log_strain', b%log_strain)
+       end associate
+    end do
+    call checkpoint_end_write(ck)
+  end subroutine save_checkpoint
+
+  !> Read the state back into a freshly set-up solver. Returns the step to continue in and the
+  !> output counters (frames, history rows) the output files are truncated to.
+  subroutine load_checkpoint(base, solver, step, frames, rows)
+    character(len=*), intent(in) :: base
+    type(solver_t), intent(inout) :: solver
+    integer, intent(out) :: step, frames, rows
+    type(checkpoint_t) :: ck
+    type(checkpoint_header_t) :: header
+    real(dp) :: scalars(10)
+    real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
+    integer :: counters(2), ib, i
+    character(len=16) :: tag
+
+    call checkpoint_begin_read(ck, base, solver%part%comm, header)
+    solver%step = header%step
+    solver%increment = header%increment
+    solver%step_time = header%step_time
+    solver%total_time = header%total_time
+    solver%dt = header%dt
+    step = header%step
+    frames = header%frame_count
+    rows = header%history_rows
+    call checkpoint_get(ck, 'u', solver%u)
+    call checkpoint_get(ck, 'v', solver%v)
+    call checkpoint_get(ck, 'a', solver%a)
+    call checkpoint_get(ck, 'f_int', solver%f_int)
+    call checkpoint_get(ck, 'f_ext', solver%f_ext)
+    call checkpoint_get(ck, 'reaction', solver%reaction)
+    allocate(rigid_u(3, size(solver%rigid)), rigid_v(3, size(solver%rigid)))
+    call checkpoint_get(ck, 'rigid_u', rigid_u)
+    call checkpoint_get(ck, 'rigid_v', rigid_v)
+    do i = 1, size(solver%rigid)
+       solver%rigid(i)%u = rigid_u(:, i)
+       solver%rigid(i)%v = rigid_v(:, i)
+    end do
+    call checkpoint_get(ck, 'scalars', scalars)
+    solver%e_viscous = scalars(1)
+    solver%e_artificial = scalars(2)
+    solver%e_friction = scalars(3)
+    solver%e_external = scalars(4)
+    solver%step_start = scalars(5)
+    solver%dt_prev = scalars(6)
+    solver%dt_stable = scalars(7)
+    call checkpoint_get(ck, 'counters', counters)
+    solver%step_increment = counters(1)
+    solver%dt_element = counters(2)
+    do ib = 1, solver%n_blocks
+       write (tag, '(a,i0,a)') 'b', ib, '_'
+       associate (b => solver%blocks(ib))
+         call checkpoint_get(ck, trim(tag) // 'rotation', b%rotation)
+         call checkpoint_get(ck, trim(tag) // 'hourglass', b%hourglass)
+         call checkpoint_get(ck, trim(tag) // 'stress', b%stress)
+         call checkpoint_get(ck, trim(tag) // 'stress_global', b%stress_global)
+         call checkpoint_get(ck, trim(tag) // 'state', b%state)
+         call checkpoint_get(ck, trim(tag) // 'field', b%field)
+         call checkpoint_get(ck, trim(tag) // 'e_int', b%e_int)
+         call checkpoint_get(ck, trim(tag) // 'e_inel', b%e_inel)
+         call checkpoint_get(ck, trim(tag) // 'log_strain', b%log_strain)
+       end associate
+    end do
+    call checkpoint_end_read(ck)
+    solver%restart_next_field = scalars(8)
+    solver%restart_next_history = scalars(9)
+    solver%restart_energy_reference = scalars(10)
+  end subroutine load_checkpoint
+
+  function rigid_array(solver, displacement) result(values)
+    type(solver_t), intent(in) :: solver
+    logical, intent(in) :: displacement
+    real(dp) :: values(3, size(solver%rigid))
+    integer :: i
+
+    do i = 1, size(solver%rigid)
+       values(:, i) = merge(solver%rigid(i)%u, solver%rigid(i)%v, displacement)
+    end do
+  end function rigid_array
+end module driver_checkpoint

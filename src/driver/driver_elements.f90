@@ -1,0 +1,226 @@
+!> The element phase of an increment, block by block: kinematics on the mid-increment
+!> configuration, corotational strain increment, [VUSDFLD] + VUMAT, stress back to the global
+!> frame, bulk viscosity, internal and hourglass forces, element stable increment and energies.
+!> Each block writes its element forces into solver%fe for the deterministic assembly.
+module driver_elements
+  use material_kinds, only: dp
+  use error_report, only: raise_error
+  use model, only: model_t
+  use model_mesh, only: element_cpe4r
+  use driver_solver, only: solver_t, element_block_t
+  use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
+       effect_bulk_viscosity, effect_user_field
+  use driver_vumat_call, only: vumat_work_t, call_material
+  use fem_cpe4r, only: cpe4r_kinematics, cpe4r_internal_force, cpe4r_hourglass
+  use fem_c3d8r, only: c3d8r_kinematics, c3d8r_internal_force, c3d8r_hourglass
+  use fem_corotation, only: corotational_increment, deformation_gradient, to_global, vumat_defgrad, &
+       vumat_stretch
+  use fem_bulk_viscosity, only: bulk_viscosity
+  use fem_stable_dt, only: element_stable_dt
+  use fem_inversion, only: check_inversion, inversion_reason_text, default_min_volume_ratio
+  implicit none
+  private
+
+  !> Per-block work arrays of the element phase, sized once for the largest block.
+  type, public :: element_work_t
+     real(dp), allocatable :: xe_old(:, :, :), du(:, :, :), xe_mid(:, :, :), xe_new(:, :, :)
+     real(dp), allocatable :: bmat_mid(:, :, :), bmat_new(:, :, :), fe(:, :, :)
+     real(dp), allocatable :: volume_mid(:), volume_new(:), char_length(:), density(:), modulus(:)
+     real(dp), allocatable :: wave_speed(:), sigma_bv(:), xi(:), e_bv(:), e_hg(:), dt_el(:)
+     real(dp), allocatable :: strain_inc(:, :), spin_inc(:, :), strain_corot(:, :), rel_spin(:, :)
+     real(dp), allocatable :: r_mid(:, :, :), r_new(:, :, :), f_old(:, :, :), f_new(:, :, :)
+     real(dp), allocatable :: stretch_old(:, :), stretch_new(:, :), defgrad_old(:, :), defgrad_new(:, :)
+     real(dp), allocatable :: stress_force(:, :)
+     integer, allocatable :: reason(:)
+     type(vumat_work_t) :: vumat
+  end type element_work_t
+
+  public :: element_work_init, element_phase
+
+contains
+
+  subroutine element_work_init(w, nmax, ndim, nen, ncomp, nshr)
+    type(element_work_t), intent(inout) :: w
+    integer, intent(in) :: nmax, ndim, nen, ncomp, nshr
+
+    allocate(w%xe_old(nmax, ndim, nen), w%du(nmax, ndim, nen), w%xe_mid(nmax, ndim, nen))
+    allocate(w%xe_new(nmax, ndim, nen), w%bmat_mid(nmax, ndim, nen), w%bmat_new(nmax, ndim, nen))
+    allocate(w%fe(nmax, ndim, nen))
+    allocate(w%volume_mid(nmax), w%volume_new(nmax), w%char_length(nmax), w%density(nmax))
+    allocate(w%modulus(nmax), w%wave_speed(nmax), w%sigma_bv(nmax), w%xi(nmax), w%e_bv(nmax))
+    allocate(w%e_hg(nmax), w%dt_el(nmax), w%reason(nmax))
+    allocate(w%strain_inc(nmax, ncomp), w%spin_inc(nmax, nshr), w%strain_corot(nmax, ncomp))
+    allocate(w%rel_spin(nmax, nshr), w%stress_force(nmax, ncomp))
+    allocate(w%r_mid(nmax, ndim, ndim), w%r_new(nmax, ndim, ndim), w%f_old(nmax, ndim, ndim))
+    allocate(w%f_new(nmax, ndim, ndim))
+    allocate(w%stretch_old(nmax, ncomp), w%stretch_new(nmax, ncomp))
+    allocate(w%defgrad_old(nmax, ncomp + nshr), w%defgrad_new(nmax, ncomp + nshr))
+    w%e_bv = 0
+    w%e_hg = 0
+  end subroutine element_work_init
+
+  !> All blocks of this rank for one increment. x_old = x0 + u_n and du = dt v_{n+1/2} per node.
+  !> Sets solver%fe, the element energies, and returns the smallest element stable increment
+  !> (unscaled) with the user number of its element. Stops with the element number, the time and
+  !> the reason when an element inverts or collapses.
+  subroutine element_phase(m, solver, effects, w, x_old, du, dt, b1, b2, hourglass_kind, &
+       hourglass_coefficient, dt_min, dt_elem)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(inout) :: solver
+    type(effects_t), intent(inout) :: effects
+    type(element_work_t), intent(inout) :: w
+    real(dp), intent(in) :: x_old(:, :), du(:, :), dt, b1, b2
+    integer, intent(in) :: hourglass_kind
+    real(dp), intent(in) :: hourglass_coefficient
+    real(dp), intent(out) :: dt_min
+    integer, intent(out) :: dt_elem
+    integer :: ib, nb, e, a, i, nd, ne, k
+
+    dt_min = huge(1.0_dp)
+    dt_elem = 0
+    nd = solver%ndim
+    ne = solver%nen
+    ! The 'elements' timer runs except while a nested effect (material, hourglass, ...) has its
+    ! own, so the shares in the report add up to the wall time.
+    call effects%start(effect_elements)
+    do ib = 1, solver%n_blocks
+       associate (blk => solver%blocks(ib))
+         nb = blk%count
+         do a = 1, ne
+            do i = 1, nd
+               do e = 1, nb
+                  k = solver%part%conn(a, blk%first + e - 1)
+                  w%xe_old(e, i, a) = x_old(i, k)
+                  w%du(e, i, a) = du(i, k)
+               end do
+            end do
+         end do
+         w%xe_mid(1:nb, :, :) = w%xe_old(1:nb, :, :) + 0.5_dp * w%du(1:nb, :, :)
+         w%xe_new(1:nb, :, :) = w%xe_old(1:nb, :, :) + w%du(1:nb, :, :)
+         call block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2, hourglass_kind, &
+              hourglass_coefficient)
+         do e = 1, nb
+            if (w%dt_el(e) < dt_min) then
+               dt_min = w%dt_el(e)
+               dt_elem = blk%elem_number(e)
+            end if
+         end do
+         solver%fe(blk%first:blk%first + nb - 1, :, :) = w%fe(1:nb, :, :)
+       end associate
+    end do
+    call effects%stop(effect_elements)
+  end subroutine element_phase
+
+  subroutine block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2, hourglass_kind, &
+       hourglass_coefficient)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(inout) :: solver
+    type(element_block_t), intent(inout) :: blk
+    type(effects_t), intent(inout) :: effects
+    type(element_work_t), intent(inout) :: w
+    integer, intent(in) :: nb, nd, ne
+    real(dp), intent(in) :: dt, b1, b2
+    integer, intent(in) :: hourglass_kind
+    real(dp), intent(in) :: hourglass_coefficient
+    integer :: e, nc, ns
+    character(len=160) :: text
+    logical :: plane
+
+    nc = solver%ncomp
+    ns = solver%nshr
+    plane = m%mesh%element_type == element_cpe4r
+    if (plane) then
+       call cpe4r_kinematics(nb, blk%thickness, w%xe_mid(1:nb, :, :), w%du(1:nb, :, :), &
+            w%xe_new(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), w%strain_inc(1:nb, :), &
+            w%spin_inc(1:nb, :), w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%char_length(1:nb))
+    else
+       call c3d8r_kinematics(nb, w%xe_mid(1:nb, :, :), w%du(1:nb, :, :), w%xe_new(1:nb, :, :), &
+            w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), &
+            w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%char_length(1:nb))
+    end if
+    call check_inversion(nb, nd, ne, w%xe_new(1:nb, :, :), w%volume_new(1:nb), blk%volume_ref, &
+         default_min_volume_ratio, w%reason(1:nb))
+    if (any(w%reason(1:nb) /= 0)) then
+       e = findloc(w%reason(1:nb) /= 0, .true., dim=1)
+       write (text, '(a,i0,a,es12.5,a)') 'element ', blk%elem_number(e), ' at total time ', &
+            solver%total_time + dt, ': ' // inversion_reason_text(w%reason(e)) // &
+            ' (increment too large, mesh too coarse for the deformation, or material too soft)'
+       call raise_error(trim(m%input_file), 0, trim(text))
+    end if
+
+    call corotational_increment(nb, nd, ne, blk%bmat_ref, w%xe_mid(1:nb, :, :), w%xe_new(1:nb, :, :), &
+         w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), blk%rotation, w%r_mid(1:nb, :, :), &
+         w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%strain_corot(1:nb, :), w%rel_spin(1:nb, :))
+    call deformation_gradient(nb, nd, ne, blk%bmat_ref, w%xe_old(1:nb, :, :), w%f_old(1:nb, :, :))
+    call vumat_defgrad(nb, nd, w%f_old(1:nb, :, :), w%defgrad_old(1:nb, :))
+    call vumat_defgrad(nb, nd, w%f_new(1:nb, :, :), w%defgrad_new(1:nb, :))
+    call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
+    call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
+    ! Current density at mid-increment, as Abaqus passes it (mass is conserved per element).
+    w%density(1:nb) = blk%mass / abs(w%volume_mid(1:nb))
+
+    call effects%stop(effect_elements)
+    call effects%start(effect_material)
+    call call_material(m%materials(blk%material), nb, nc, ns, blk%elem_number, solver%step_time + dt, &
+         solver%total_time + dt, dt, w%char_length(1:nb), w%density(1:nb), w%strain_corot(1:nb, :), &
+         w%rel_spin(1:nb, :), w%stretch_old(1:nb, :), w%stretch_new(1:nb, :), w%defgrad_old(1:nb, :), &
+         w%defgrad_new(1:nb, :), blk%log_strain, blk%stress, blk%state, blk%field, blk%e_int, &
+         blk%e_inel, w%vumat)
+    call effects%stop(effect_material)
+    if (m%materials(blk%material)%user_field) then
+       ! LE for vgetvrm: VUSDFLD has just seen the start-of-increment value.
+       call effects%start(effect_user_field)
+       blk%log_strain = blk%log_strain + w%strain_corot(1:nb, :)
+       call effects%stop(effect_user_field)
+    end if
+    call effects%start(effect_elements)
+    blk%rotation = w%r_new(1:nb, :, :)
+    call to_global(nb, nd, nc, blk%rotation, blk%stress, blk%stress_global)
+
+    w%wave_speed(1:nb) = sqrt(blk%wave_modulus / w%density(1:nb))
+    w%stress_force(1:nb, :) = blk%stress_global
+    w%xi(1:nb) = 0
+    if (effects%active(effect_bulk_viscosity)) then
+       call effects%stop(effect_elements)
+       call effects%start(effect_bulk_viscosity)
+       call bulk_viscosity(nb, nc, w%strain_inc(1:nb, :), dt, w%density(1:nb), w%wave_speed(1:nb), &
+            w%char_length(1:nb), abs(w%volume_mid(1:nb)), b1, b2, w%sigma_bv(1:nb), w%xi(1:nb), &
+            w%e_bv(1:nb))
+       do e = 1, 3
+          w%stress_force(1:nb, e) = w%stress_force(1:nb, e) + w%sigma_bv(1:nb)
+       end do
+       solver%e_viscous = solver%e_viscous + sum(w%e_bv(1:nb))
+       call effects%stop(effect_bulk_viscosity)
+       call effects%start(effect_elements)
+    end if
+    if (plane) then
+       call cpe4r_internal_force(nb, w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%stress_force(1:nb, :), &
+            w%fe(1:nb, :, :))
+    else
+       call c3d8r_internal_force(nb, w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%stress_force(1:nb, :), &
+            w%fe(1:nb, :, :))
+    end if
+
+    if (effects%active(effect_hourglass)) then
+       call effects%stop(effect_elements)
+       call effects%start(effect_hourglass)
+       w%modulus(1:nb) = blk%wave_modulus
+       if (plane) then
+          call cpe4r_hourglass(nb, blk%thickness, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), &
+               w%bmat_mid(1:nb, :, :), w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), &
+               hourglass_kind, hourglass_coefficient, w%r_mid(1:nb, :, :), blk%rotation, blk%hourglass, &
+               w%fe(1:nb, :, :), w%e_hg(1:nb))
+       else
+          call c3d8r_hourglass(nb, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), &
+               w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), hourglass_kind, &
+               hourglass_coefficient, w%r_mid(1:nb, :, :), blk%rotation, blk%hourglass, w%fe(1:nb, :, :), &
+               w%e_hg(1:nb))
+       end if
+       solver%e_artificial = solver%e_artificial + sum(w%e_hg(1:nb))
+       call effects%stop(effect_hourglass)
+       call effects%start(effect_elements)
+    end if
+    ! The next increment's stable time uses the current geometry and the damping just found.
+    call element_stable_dt(nb, w%char_length(1:nb), w%wave_speed(1:nb), w%xi(1:nb), w%dt_el(1:nb))
+  end subroutine block_increment
+end module driver_elements

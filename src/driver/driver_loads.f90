@@ -1,0 +1,315 @@
+!> Loads and constraints of the current step on this rank's nodes: prescribed velocities and
+!> displacements (with amplitudes), rigid-body reference nodes, gravity, and rigid-wall contact.
+!> prepare_step turns the step's global, user-facing lists into local index lists once, so the
+!> increment loop touches only arrays.
+module driver_loads
+  use material_kinds, only: dp
+  use model, only: model_t
+  use model_steps, only: bc_velocity
+  use parallel_partition, only: partition_t, local_node_index, local_elem_index
+  use parallel_assembly, only: assemble_element_vectors
+  use driver_solver, only: solver_t
+  use contact_rigid_wall, only: rigid_wall_contact
+  implicit none
+  private
+
+  type :: prescribed_t
+     integer :: node = 0, dof = 0            !< local node (or rigid surface for rigid lists)
+     integer :: kind = 0, amplitude = 0
+     real(dp) :: value = 0
+  end type prescribed_t
+
+  type :: gravity_local_t
+     real(dp) :: g(3) = 0
+     integer :: amplitude = 0
+     real(dp), allocatable :: mass(:)         !< (n_local_nodes) lumped mass of the loaded elements
+  end type gravity_local_t
+
+  type :: contact_local_t
+     integer :: wall = 0
+     real(dp) :: mu = 0
+     integer, allocatable :: owned(:), others(:)   !< local slave nodes this rank owns / does not
+  end type contact_local_t
+
+  type, public :: step_loads_t
+     integer :: n_prescribed = 0, n_rigid = 0
+     type(prescribed_t), allocatable :: prescribed(:), rigid(:)
+     type(gravity_local_t), allocatable :: gravity(:)
+     type(contact_local_t), allocatable :: contact(:)
+  end type step_loads_t
+
+  public :: prepare_step, apply_prescribed_velocities, apply_rigid_body_velocities, gravity_forces, &
+       apply_contact
+
+contains
+
+  subroutine prepare_step(m, istep, solver, loads)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: istep
+    type(solver_t), intent(inout) :: solver
+    type(step_loads_t), intent(out) :: loads
+    integer :: ib, i, j, k, dof, n, nr, r, g, le, a, e
+    real(dp), allocatable :: fe(:, :, :), gm(:, :)
+    logical :: found
+
+    associate (s => m%steps(istep), part => solver%part)
+      ! Prescribed dofs: nodes of the deformable mesh, and reference nodes of rigid surfaces.
+      n = 0
+      nr = 0
+      if (allocated(s%boundaries)) then
+         do ib = 1, size(s%boundaries)
+            associate (b => s%boundaries(ib))
+              n = n + size(b%nodes) * (b%last_dof - b%first_dof + 1)
+            end associate
+         end do
+      end if
+      allocate(loads%prescribed(max(1, n)), loads%rigid(max(1, n)))
+      n = 0
+      solver%fixed = .false.
+      if (allocated(s%boundaries)) then
+         do ib = 1, size(s%boundaries)
+            associate (b => s%boundaries(ib))
+              do i = 1, size(b%nodes)
+                 do dof = b%first_dof, min(b%last_dof, solver%ndim)
+                    found = .false.
+                    do r = 1, m%n_rigid_surfaces
+                       if (m%rigid_surfaces(r)%ref_node == b%nodes(i)) then
+                          nr = nr + 1
+                          loads%rigid(nr) = prescribed_t(r, dof, b%kind, b%amplitude, b%value)
+                          found = .true.
+                       end if
+                    end do
+                    if (found) cycle
+                    k = local_node_index(part, b%nodes(i))
+                    if (k == 0) cycle
+                    n = n + 1
+                    loads%prescribed(n) = prescribed_t(k, dof, b%kind, b%amplitude, b%value)
+                    solver%fixed(dof, k) = .true.
+                 end do
+              end do
+            end associate
+         end do
+      end if
+      loads%n_prescribed = n
+      loads%n_rigid = nr
+
+      ! Gravity: the lumped mass of the loaded elements at each node, assembled like the mass.
+      if (allocated(s%gravity)) then
+         allocate(loads%gravity(size(s%gravity)))
+         allocate(fe(part%n_local_elems, 1, solver%nen), gm(1, solver%n_nodes))
+         do g = 1, size(s%gravity)
+            fe = 0
+            do ib = 1, solver%n_blocks
+               associate (blk => solver%blocks(ib))
+                 do e = 1, blk%count
+                    le = blk%first + e - 1
+                    if (s%gravity(g)%elset > 0) then
+                       if (.not. in_set(m%elsets(s%gravity(g)%elset)%members, part%elem_global(le))) cycle
+                    end if
+                    do a = 1, solver%nen
+                       fe(le, 1, a) = blk%mass(e) / solver%nen
+                    end do
+                 end do
+               end associate
+            end do
+            call assemble_element_vectors(part, 1, fe, gm)
+            loads%gravity(g)%mass = gm(1, :)
+            loads%gravity(g)%g = s%gravity(g)%magnitude * s%gravity(g)%direction
+            loads%gravity(g)%amplitude = s%gravity(g)%amplitude
+         end do
+      else
+         allocate(loads%gravity(0))
+      end if
+
+      ! Contact pairs: the slave nodes present on this rank, owned ones apart (they alone count
+      ! in forces and frictional work, so shared nodes are not counted twice across ranks).
+      if (allocated(s%contact_pairs)) then
+         allocate(loads%contact(size(s%contact_pairs)))
+         do j = 1, size(s%contact_pairs)
+            associate (cp => s%contact_pairs(j), c => loads%contact(j))
+              c%wall = cp%rigid_surface
+              c%mu = 0
+              if (cp%interaction > 0) c%mu = m%interactions(cp%interaction)%friction
+              call split_slaves(part, m%element_surfaces(cp%slave_surface)%nodes, c%owned, c%others)
+            end associate
+         end do
+      else
+         allocate(loads%contact(0))
+      end if
+    end associate
+  end subroutine prepare_step
+
+  subroutine split_slaves(part, nodes, owned, others)
+    type(partition_t), intent(in) :: part
+    integer, intent(in) :: nodes(:)
+    integer, allocatable, intent(out) :: owned(:), others(:)
+    integer :: i, k, no, nt
+
+    allocate(owned(size(nodes)), others(size(nodes)))
+    no = 0
+    nt = 0
+    do i = 1, size(nodes)
+       k = local_node_index(part, nodes(i))
+       if (k == 0) cycle
+       if (part%node_owned(k)) then
+          no = no + 1
+          owned(no) = k
+       else
+          nt = nt + 1
+          others(nt) = k
+       end if
+    end do
+    owned = owned(1:no)
+    others = others(1:nt)
+  end subroutine split_slaves
+
+  pure logical function in_set(members, g)
+    integer, intent(in) :: members(:), g
+    integer :: lo, hi, mid
+
+    in_set = .false.
+    lo = 1
+    hi = size(members)
+    do while (lo <= hi)
+       mid = (lo + hi) / 2
+       if (members(mid) == g) then
+          in_set = .true.
+          return
+       else if (members(mid) < g) then
+          lo = mid + 1
+       else
+          hi = mid - 1
+       end if
+    end do
+  end function in_set
+
+  !> Overwrite v_{n+1/2} on prescribed dofs: a velocity BC gives value·A(t_{n+1/2}); a
+  !> displacement BC the velocity that reaches value·A(t_{n+1}) at the end of the increment.
+  subroutine apply_prescribed_velocities(m, loads, solver, step_time_mid, step_time_new, dt)
+    type(model_t), intent(in) :: m
+    type(step_loads_t), intent(in) :: loads
+    type(solver_t), intent(inout) :: solver
+    real(dp), intent(in) :: step_time_mid, step_time_new, dt
+    integer :: i
+    real(dp) :: amp_mid, amp_new
+
+    do i = 1, loads%n_prescribed
+       associate (p => loads%prescribed(i))
+         call amplitudes(m, p%amplitude, solver%step_start, step_time_mid, step_time_new, amp_mid, amp_new)
+         if (p%kind == bc_velocity) then
+            solver%v(p%dof, p%node) = p%value * amp_mid
+         else
+            solver%v(p%dof, p%node) = (p%value * amp_new - solver%u(p%dof, p%node)) / dt
+         end if
+       end associate
+    end do
+  end subroutine apply_prescribed_velocities
+
+  !> Velocities of the rigid surfaces' reference nodes over the increment (unconstrained dofs
+  !> of a reference node do not move: walls are driven, not free bodies).
+  subroutine apply_rigid_body_velocities(m, loads, solver, step_time_mid, step_time_new, dt)
+    type(model_t), intent(in) :: m
+    type(step_loads_t), intent(in) :: loads
+    type(solver_t), intent(inout) :: solver
+    real(dp), intent(in) :: step_time_mid, step_time_new, dt
+    integer :: i
+    real(dp) :: amp_mid, amp_new
+
+    do i = 1, size(solver%rigid)
+       solver%rigid(i)%v = 0
+    end do
+    do i = 1, loads%n_rigid
+       associate (p => loads%rigid(i), body => solver%rigid(loads%rigid(i)%node))
+         call amplitudes(m, p%amplitude, solver%step_start, step_time_mid, step_time_new, amp_mid, amp_new)
+         if (p%kind == bc_velocity) then
+            body%v(p%dof) = p%value * amp_mid
+         else
+            body%v(p%dof) = (p%value * amp_new - body%u(p%dof)) / dt
+         end if
+       end associate
+    end do
+  end subroutine apply_rigid_body_velocities
+
+  !> Amplitude factors at the middle and the end of the increment; no amplitude: 1 (Abaqus's
+  !> step amplitude for displacement and velocity boundary conditions in Explicit).
+  subroutine amplitudes(m, id, step_start, t_mid, t_new, a_mid, a_new)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: id
+    real(dp), intent(in) :: step_start, t_mid, t_new
+    real(dp), intent(out) :: a_mid, a_new
+
+    if (id == 0) then
+       a_mid = 1
+       a_new = 1
+    else
+       a_mid = m%amplitudes(id)%value(t_mid, step_start + t_mid)
+       a_new = m%amplitudes(id)%value(t_new, step_start + t_new)
+    end if
+  end subroutine amplitudes
+
+  !> f_ext = Σ gravity loads at the given step time.
+  subroutine gravity_forces(m, loads, solver, step_time, f_ext)
+    type(model_t), intent(in) :: m
+    type(step_loads_t), intent(in) :: loads
+    type(solver_t), intent(in) :: solver
+    real(dp), intent(in) :: step_time
+    real(dp), intent(out) :: f_ext(:, :)
+    integer :: g, i
+    real(dp) :: amp
+
+    f_ext = 0
+    do g = 1, size(loads%gravity)
+       amp = 1
+       if (loads%gravity(g)%amplitude > 0) amp = m%amplitudes(loads%gravity(g)%amplitude)%value(step_time, &
+            solver%step_start + step_time)
+       do i = 1, solver%n_nodes
+          f_ext(:, i) = f_ext(:, i) + loads%gravity(g)%mass(i) * amp * loads%gravity(g)%g(1:solver%ndim)
+       end do
+    end do
+  end subroutine gravity_forces
+
+  !> Kinematic contact of every active pair on v_{n+1/2}. Two passes settle nodes held by two
+  !> walls (a concave corner: hopper wall and outlet plate). Returns the frictional work of this
+  !> rank's owned slaves; f_contact gets the contact forces of owned slaves and wall_force the
+  !> force on each wall (minus the force on the material).
+  subroutine apply_contact(m, loads, solver, dt, friction_work)
+    type(model_t), intent(in) :: m
+    type(step_loads_t), intent(in) :: loads
+    type(solver_t), intent(inout) :: solver
+    real(dp), intent(in) :: dt
+    real(dp), intent(out) :: friction_work
+    integer :: j, pass, npass, i, nd
+    real(dp), allocatable :: x(:, :), force(:, :)
+    logical, allocatable :: touching(:)
+    real(dp) :: work
+
+    nd = solver%ndim
+    friction_work = 0
+    solver%f_contact = 0
+    solver%wall_force = 0
+    if (size(loads%contact) == 0) return
+    allocate(x(nd, solver%n_nodes))
+    x = solver%x0 + solver%u
+    npass = merge(2, 1, size(loads%contact) > 1)
+    do pass = 1, npass
+       do j = 1, size(loads%contact)
+          associate (c => loads%contact(j), wall => m%rigid_surfaces(loads%contact(j)%wall), &
+               body => solver%rigid(loads%contact(j)%wall))
+            allocate(force(nd, size(c%owned)), touching(size(c%owned)))
+            call rigid_wall_contact(nd, solver%n_nodes, x, solver%v, solver%mass, c%owned, dt, wall, &
+                 body%u(1:nd), body%v(1:nd), c%mu, force, work, touching)
+            friction_work = friction_work + work
+            do i = 1, size(c%owned)
+               solver%f_contact(:, c%owned(i)) = solver%f_contact(:, c%owned(i)) + force(:, i)
+               solver%wall_force(:, c%wall) = solver%wall_force(:, c%wall) - force(:, i)
+            end do
+            deallocate(force, touching)
+            allocate(force(nd, size(c%others)), touching(size(c%others)))
+            call rigid_wall_contact(nd, solver%n_nodes, x, solver%v, solver%mass, c%others, dt, wall, &
+                 body%u(1:nd), body%v(1:nd), c%mu, force, work, touching)
+            deallocate(force, touching)
+          end associate
+       end do
+    end do
+  end subroutine apply_contact
+end module driver_loads

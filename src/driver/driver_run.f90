@@ -1,0 +1,366 @@
+!> The explicit time integration of a whole scene: steps in sequence, each increment as the named
+!> phases of the central-difference scheme (docs/solver_interfaces.md §0), with output,
+!> progress, checkpoints and restart. The increment reads like a table of contents; each phase
+!> lives in its own module.
+module driver_run
+  use, intrinsic :: iso_fortran_env, only: output_unit
+  use mpi_f08, only: MPI_Comm
+  use material_kinds, only: dp
+  use error_report, only: raise_error
+  use model, only: model_t
+  use model_mesh, only: element_cpe4r
+  use parallel_partition, only: partition_t, partition_model
+  use parallel_assembly, only: assemble_element_vectors, global_min, global_sum
+  use driver_solver, only: solver_t, block_size
+  use driver_effects, only: effects_t, effect_gravity, effect_rigid_walls, effect_boundary, &
+       effect_assembly, effect_output, effect_checkpoint, effect_user_field
+  use driver_setup, only: setup_solver, initial_internal_forces
+  use driver_elements, only: element_work_t, element_work_init, element_phase
+  use driver_vumat_call, only: vumat_work_init
+  use driver_loads, only: step_loads_t, prepare_step, apply_prescribed_velocities, &
+       apply_rigid_body_velocities, gravity_forces, apply_contact
+  use driver_output, only: run_output_t, open_run_output, close_run_output, step_output_start, &
+       output_due, write_frame, write_history, energy_values, progress_line, field_interval, &
+       history_interval, sum_over_ranks
+  use driver_checkpoint, only: save_checkpoint, load_checkpoint
+  use fem_cpe4r, only: cpe4r_char_length
+  use fem_c3d8r, only: c3d8r_char_length
+  use fem_stable_dt, only: element_stable_dt
+  use fem_hourglass, only: hourglass_viscous, default_hourglass_viscous_coefficient, &
+       default_hourglass_stiffness_coefficient
+  use output_timer, only: timer_report
+  implicit none
+  private
+
+  type, public :: run_options_t
+     character(len=:), allocatable :: output_base     !< path of the outputs without extension
+     logical :: restart = .false.                     !< continue from the checkpoint
+     integer :: stop_after = 0                        !< > 0: stop after this increment (tests)
+     logical :: progress = .true.
+  end type run_options_t
+
+  public :: run_scene
+
+contains
+
+  subroutine run_scene(m, comm, opts)
+    type(model_t), intent(in) :: m
+    type(MPI_Comm), intent(in) :: comm
+    type(run_options_t), intent(in) :: opts
+    type(partition_t) :: part
+    type(solver_t) :: solver
+    type(effects_t) :: effects
+    type(element_work_t) :: ew
+    type(step_loads_t) :: loads
+    type(run_output_t) :: out
+    integer :: istep, first_step, nmax, max_state, max_field, i, hg_kind, frames, rows
+    real(dp) :: hg_coefficient, dt_min, energies(6)
+    logical :: resumed, stop_now
+    real(dp) :: period
+
+    call partition_model(m, comm, part)
+    call effects%decide(m)
+    call setup_solver(m, part, solver, effects%active(effect_user_field))
+    nmax = min(block_size, max(1, part%n_local_elems))
+    call element_work_init(ew, nmax, solver%ndim, solver%nen, solver%ncomp, solver%nshr)
+    max_state = 1
+    max_field = 1
+    do i = 1, m%n_materials
+       max_state = max(max_state, m%materials(i)%nstatev)
+       max_field = max(max_field, m%materials(i)%nfieldv)
+    end do
+    call vumat_work_init(ew%vumat, nmax, solver%ncomp, solver%nshr, max_state, max_field)
+    hg_kind = hourglass_viscous
+    hg_coefficient = 0
+    if (m%n_sections > 0) then
+       hg_kind = m%sections(1)%hourglass
+       hg_coefficient = m%sections(1)%hourglass_coefficient
+    end if
+    if (hg_coefficient <= 0) hg_coefficient = merge(default_hourglass_viscous_coefficient, &
+         default_hourglass_stiffness_coefficient, hg_kind == hourglass_viscous)
+
+    first_step = 1
+    resumed = .false.
+    if (opts%restart) then
+       call load_checkpoint(opts%output_base, solver, first_step, frames, rows)
+       resumed = .true.
+       call open_run_output(m, solver, out, opts%output_base, frames, rows, solver%total_time)
+       out%next_field = solver%restart_next_field
+       out%next_history = solver%restart_next_history
+       out%energy_reference = solver%restart_energy_reference
+    else
+       call open_run_output(m, solver, out, opts%output_base)
+    end if
+    out%progress = opts%progress
+    if (part%rank == 0) call print_header(m, part, solver, effects, opts)
+
+    stop_now = .false.
+    do istep = first_step, m%n_steps
+       call prepare_step(m, istep, solver, loads)
+       period = m%steps(istep)%period
+       if (.not. resumed) then
+          solver%step = istep
+          solver%step_time = 0
+          solver%step_start = solver%total_time
+          solver%step_increment = 0
+          call step_output_start(out)
+          if (istep == 1) then
+             call initial_internal_forces(m, solver)
+             call gravity_forces(m, loads, solver, 0.0_dp, solver%f_ext)
+             call update_accelerations(solver)
+             solver%dt_stable = initial_stable_dt(m, solver, m%steps(1)%bulk_linear)
+             call energy_values(solver, energies)
+             out%energy_reference = energies(1) + energies(2) + energies(3) + energies(4) - energies(5)
+          end if
+          call write_outputs(m, solver, out, effects, istep)
+       end if
+       resumed = .false.
+
+       do while (solver%step_time < period * (1 - 1.0e-12_dp))
+          call one_increment(m, solver, effects, ew, loads, istep, hg_kind, hg_coefficient, dt_min)
+          call write_outputs(m, solver, out, effects, istep)
+          call progress_line(m, solver, out, istep, .false.)
+          if (effects%active(effect_checkpoint)) then
+             if (checkpoint_due(m, solver, istep) .or. solver%increment == opts%stop_after) then
+                call effects%start(effect_checkpoint)
+                call save_checkpoint(opts%output_base, solver, out)
+                call effects%stop(effect_checkpoint)
+             end if
+          end if
+          if (solver%increment == opts%stop_after) then
+             stop_now = .true.
+             exit
+          end if
+       end do
+       call progress_line(m, solver, out, istep, .true.)
+       if (stop_now) exit
+    end do
+
+    call close_run_output(out)
+    if (m%n_rigid_surfaces > 0) call sum_over_ranks(solver, solver%wall_force)
+    if (part%rank == 0) then
+       if (stop_now) write (output_unit, '(a,i0,a)') 'bulkflow: stopped after increment ', solver%increment, &
+            ' as asked (--stop-after); continue with --restart'
+       call print_summary(m, solver)
+    end if
+    call timer_report(effects%timers, output_unit, comm)
+  end subroutine run_scene
+
+  !> One central-difference increment, t_n → t_{n+1}.
+  subroutine one_increment(m, solver, effects, ew, loads, istep, hg_kind, hg_coefficient, dt_min)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(inout) :: solver
+    type(effects_t), intent(inout) :: effects
+    type(element_work_t), intent(inout) :: ew
+    type(step_loads_t), intent(in) :: loads
+    integer, intent(in) :: istep, hg_kind
+    real(dp), intent(in) :: hg_coefficient
+    real(dp), intent(out) :: dt_min
+    real(dp) :: dt, dt_avg, t_mid, t_new, work
+    integer :: i, dt_elem
+
+    associate (s => m%steps(istep))
+      ! Time increment: the stable one (scaled), or the user's; never past the end of the step.
+      if (s%dt_fixed > 0) then
+         dt = s%dt_fixed
+      else
+         dt = s%dt_scale * solver%dt_stable
+      end if
+      dt = min(dt, s%period - solver%step_time)
+      solver%dt = dt
+      t_mid = solver%step_time + 0.5_dp * dt
+      t_new = solver%step_time + dt
+
+      ! Velocities at mid-increment (the first increment of the run starts from v_0 with dt/2).
+      dt_avg = merge(0.5_dp * dt, 0.5_dp * (solver%dt_prev + dt), solver%increment == 0)
+      solver%v = solver%v + dt_avg * solver%a
+
+      if (effects%active(effect_boundary)) then
+         call effects%start(effect_boundary)
+         call apply_prescribed_velocities(m, loads, solver, t_mid, t_new, dt)
+         call apply_rigid_body_velocities(m, loads, solver, t_mid, t_new, dt)
+         call effects%stop(effect_boundary)
+      end if
+      if (effects%active(effect_rigid_walls)) then
+         call effects%start(effect_rigid_walls)
+         call apply_contact(m, loads, solver, dt, work)
+         solver%e_friction = solver%e_friction + work
+         ! A prescribed dof wins over contact, as in Abaqus.
+         call apply_prescribed_velocities(m, loads, solver, t_mid, t_new, dt)
+         call effects%stop(effect_rigid_walls)
+      end if
+
+      solver%du = dt * solver%v
+      call element_phase(m, solver, effects, ew, solver%x0 + solver%u, solver%du, dt, s%bulk_linear, &
+           s%bulk_quadratic, hg_kind, hg_coefficient, dt_min, dt_elem)
+      solver%u = solver%u + solver%du
+      do i = 1, size(solver%rigid)
+         solver%rigid(i)%u = solver%rigid(i)%u + dt * solver%rigid(i)%v
+      end do
+
+      call effects%start(effect_assembly)
+      call assemble_element_vectors(solver%part, solver%ndim, solver%fe, solver%f_int)
+      call effects%stop(effect_assembly)
+      solver%f_ext_old = solver%f_ext
+      if (effects%active(effect_gravity)) then
+         call effects%start(effect_gravity)
+         call gravity_forces(m, loads, solver, t_new, solver%f_ext)
+         call effects%stop(effect_gravity)
+      end if
+      solver%reaction_old = solver%reaction
+      call update_accelerations(solver)
+
+      ! External work of this rank's owned nodes: gravity (trapezoidal), supports and walls.
+      do i = 1, solver%n_nodes
+         if (.not. solver%part%node_owned(i)) cycle
+         solver%e_external = solver%e_external + sum((0.5_dp * (solver%f_ext_old(:, i) + solver%f_ext(:, i)) &
+              + 0.5_dp * (solver%reaction_old(:, i) + solver%reaction(:, i)) + solver%f_contact(:, i)) &
+              * solver%du(:, i))
+      end do
+
+      solver%step_time = t_new
+      solver%total_time = solver%step_start + t_new
+      solver%increment = solver%increment + 1
+      solver%step_increment = solver%step_increment + 1
+      solver%dt_prev = dt
+      call global_min(solver%part, dt_min)
+      solver%dt_stable = dt_min
+      solver%dt_element = dt_elem
+    end associate
+  end subroutine one_increment
+
+  !> a = (f_ext − f_int)/m on free dofs; reactions f_int − f_ext on prescribed ones.
+  subroutine update_accelerations(solver)
+    type(solver_t), intent(inout) :: solver
+    integer :: i, j
+
+    do i = 1, solver%n_nodes
+       do j = 1, solver%ndim
+          if (solver%fixed(j, i)) then
+             solver%a(j, i) = 0
+             solver%reaction(j, i) = solver%f_int(j, i) - solver%f_ext(j, i)
+          else
+             solver%a(j, i) = (solver%f_ext(j, i) - solver%f_int(j, i)) / solver%mass(i)
+             solver%reaction(j, i) = 0
+          end if
+       end do
+    end do
+  end subroutine update_accelerations
+
+  subroutine write_outputs(m, solver, out, effects, istep)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(inout) :: solver
+    type(run_output_t), intent(inout) :: out
+    type(effects_t), intent(inout) :: effects
+    integer, intent(in) :: istep
+    real(dp) :: period, interval
+
+    period = m%steps(istep)%period
+    call effects%start(effect_output)
+    interval = field_interval(m, istep)
+    if (interval > 0) then
+       if (output_due(solver%step_time, out%next_field, period, solver%dt)) then
+          call write_frame(m, solver, out, istep)
+          do while (out%next_field <= solver%step_time + 1.0e-9_dp * period)
+             out%next_field = out%next_field + interval
+          end do
+       end if
+    end if
+    interval = history_interval(m, istep)
+    if (output_due(solver%step_time, out%next_history, period, solver%dt)) then
+       call write_history(m, solver, out, istep)
+       do while (out%next_history <= solver%step_time + 1.0e-9_dp * period)
+          out%next_history = out%next_history + interval
+       end do
+    end if
+    call effects%stop(effect_output)
+  end subroutine write_outputs
+
+  logical function checkpoint_due(m, solver, istep)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(in) :: solver
+    integer, intent(in) :: istep
+    real(dp) :: interval, before
+
+    checkpoint_due = .false.
+    if (.not. m%steps(istep)%restart_write) return
+    interval = m%steps(istep)%restart_interval
+    if (interval <= 0) then
+       checkpoint_due = solver%step_time >= m%steps(istep)%period * (1 - 1.0e-12_dp)
+       return
+    end if
+    before = solver%step_time - solver%dt
+    checkpoint_due = floor(solver%step_time / interval + 1.0e-9_dp) > floor(before / interval + 1.0e-9_dp)
+  end function checkpoint_due
+
+  !> Stable increment of the undeformed mesh: L_e / c_d with the linear bulk-viscosity damping.
+  real(dp) function initial_stable_dt(m, solver, b1)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(in) :: solver
+    real(dp), intent(in) :: b1
+    integer :: ib, nb, e, a, i
+    real(dp), allocatable :: xe(:, :, :), lc(:), c(:), xi(:), dte(:)
+
+    initial_stable_dt = huge(1.0_dp)
+    do ib = 1, solver%n_blocks
+       associate (blk => solver%blocks(ib))
+         nb = blk%count
+         allocate(xe(nb, solver%ndim, solver%nen), lc(nb), c(nb), xi(nb), dte(nb))
+         do a = 1, solver%nen
+            do i = 1, solver%ndim
+               do e = 1, nb
+                  xe(e, i, a) = solver%x0(i, solver%part%conn(a, blk%first + e - 1))
+               end do
+            end do
+         end do
+         if (m%mesh%element_type == element_cpe4r) then
+            call cpe4r_char_length(nb, xe, lc)
+         else
+            call c3d8r_char_length(nb, xe, blk%volume_ref, lc)
+         end if
+         c = sqrt(blk%wave_modulus / (blk%mass / blk%volume_ref))
+         xi = b1
+         call element_stable_dt(nb, lc, c, xi, dte)
+         initial_stable_dt = min(initial_stable_dt, minval(dte))
+         deallocate(xe, lc, c, xi, dte)
+       end associate
+    end do
+    call global_min(solver%part, initial_stable_dt)
+  end function initial_stable_dt
+
+  subroutine print_header(m, part, solver, effects, opts)
+    type(model_t), intent(in) :: m
+    type(partition_t), intent(in) :: part
+    type(solver_t), intent(in) :: solver
+    type(effects_t), intent(in) :: effects
+    type(run_options_t), intent(in) :: opts
+
+    write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
+    write (output_unit, '(a,i0,a,i0,a,i0,a,i0,a)') '  model     ', m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, &
+         ' elements, ', m%n_steps, ' step(s), ', part%nranks, ' rank(s)'
+    write (output_unit, '(a)') '  effects   ' // effects%active_list()
+    write (output_unit, '(a)') '  output    ' // opts%output_base // '.h5/.xmf, ' // opts%output_base // &
+         '_history.csv'
+    if (opts%restart) write (output_unit, '(a,i0,a,es12.5)') '  restart   from increment ', solver%increment, &
+         ' at t = ', solver%total_time
+    flush (output_unit)
+  end subroutine print_header
+
+  subroutine print_summary(m, solver)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(in) :: solver
+    integer :: i
+    real(dp) :: wall(solver%ndim, max(1, m%n_rigid_surfaces))
+
+    write (output_unit, '(a,i0,a,es12.5)') 'bulkflow: done, ', solver%increment, ' increments, t = ', &
+         solver%total_time
+    associate (e => solver%energies)
+      write (output_unit, '(a,6es12.4)') '  energies  ALLKE ALLIE ALLVD ALLFD ALLWK ALLAE:', e%kinetic, &
+           e%internal, e%viscous, e%friction, e%external, e%artificial
+    end associate
+    wall = solver%wall_force
+    do i = 1, m%n_rigid_surfaces
+       write (output_unit, '(a,3es13.5)') '  wall ' // trim(m%rigid_surfaces(i)%name) // ' force:', wall(:, i)
+    end do
+  end subroutine print_summary
+end module driver_run

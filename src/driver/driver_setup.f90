@@ -1,0 +1,232 @@
+!> Everything done once before the first increment: local nodes and element blocks from the
+!> partition, reference geometry, lumped masses, material moduli from the packaging call,
+!> initial conditions, and the internal forces of the initial stresses.
+module driver_setup
+  use material_kinds, only: dp
+  use model, only: model_t
+  use model_mesh, only: element_cpe4r
+  use parallel_partition, only: partition_t, local_node_index, local_elem_index
+  use parallel_assembly, only: assemble_element_vectors
+  use driver_solver, only: solver_t, element_block_t, build_blocks
+  use driver_vumat_call, only: packaging_modulus
+  use fem_cpe4r, only: cpe4r_geometry, cpe4r_internal_force
+  use fem_c3d8r, only: c3d8r_geometry, c3d8r_internal_force
+  use fem_corotation, only: identity_rotation
+  use fem_mass, only: lumped_mass
+  implicit none
+  private
+
+  public :: setup_solver, initial_internal_forces
+
+contains
+
+  subroutine setup_solver(m, part, solver, user_field_active)
+    type(model_t), intent(in) :: m
+    type(partition_t), intent(in) :: part
+    type(solver_t), intent(inout) :: solver
+    logical, intent(in) :: user_field_active
+    integer :: nd, nn, i, j, k, ib, nb, e, g, le
+    real(dp), allocatable :: moduli(:), mass_e(:, :, :), mass2(:, :)
+    logical, allocatable :: known(:)
+
+    solver%part = part
+    call build_blocks(m, part, solver)
+    nd = solver%ndim
+    nn = part%n_local_nodes
+    solver%n_nodes = nn
+    allocate(solver%x0(nd, nn), solver%u(nd, nn), solver%v(nd, nn), solver%a(nd, nn))
+    allocate(solver%mass(nn), solver%f_int(nd, nn), solver%f_ext(nd, nn), solver%f_contact(nd, nn))
+    allocate(solver%reaction(nd, nn), solver%fixed(nd, nn))
+    allocate(solver%du(nd, nn), solver%f_ext_old(nd, nn), solver%reaction_old(nd, nn))
+    allocate(solver%fe(part%n_local_elems, nd, solver%nen))
+    do i = 1, nn
+       solver%x0(:, i) = m%mesh%x0(:, part%node_global(i))
+    end do
+    solver%u = 0
+    solver%v = 0
+    solver%a = 0
+    solver%f_int = 0
+    solver%f_ext = 0
+    solver%f_contact = 0
+    solver%reaction = 0
+    solver%fixed = .false.
+    allocate(solver%rigid(max(1, m%n_rigid_surfaces)))
+    allocate(solver%wall_force(nd, max(1, m%n_rigid_surfaces)))
+    solver%wall_force = 0
+
+    ! P-wave modulus of each material from Abaqus's packaging call, once per material.
+    allocate(moduli(m%n_materials), known(m%n_materials))
+    known = .false.
+    do ib = 1, solver%n_blocks
+       k = solver%blocks(ib)%material
+       if (.not. known(k)) then
+          moduli(k) = packaging_modulus(m%materials(k), solver%ncomp, solver%nshr)
+          known(k) = .true.
+       end if
+    end do
+
+    allocate(mass_e(part%n_local_elems, 1, solver%nen))
+    do ib = 1, solver%n_blocks
+       call setup_block(m, part, solver, solver%blocks(ib), moduli(solver%blocks(ib)%material), &
+            user_field_active)
+       nb = solver%blocks(ib)%count
+       associate (blk => solver%blocks(ib))
+         call lumped_mass(nb, solver%nen, blk%mass / blk%volume_ref, blk%volume_ref, &
+              mass_e(blk%first:blk%first + nb - 1, 1, :))
+       end associate
+    end do
+    allocate(mass2(1, nn))
+    call assemble_element_vectors(part, 1, mass_e, mass2)
+    solver%mass = mass2(1, :)
+
+    ! Initial conditions given on global nodes and elements; keep what is local.
+    if (allocated(m%initial_velocities)) then
+       do j = 1, size(m%initial_velocities)
+          associate (ic => m%initial_velocities(j))
+            do i = 1, size(ic%nodes)
+               k = local_node_index(part, ic%nodes(i))
+               if (k > 0 .and. ic%dof <= nd) solver%v(ic%dof, k) = ic%value
+            end do
+          end associate
+       end do
+    end if
+    if (allocated(m%initial_stresses)) then
+       do j = 1, size(m%initial_stresses)
+          associate (ic => m%initial_stresses(j))
+            do i = 1, size(ic%elems)
+               le = local_elem_index(part, ic%elems(i))
+               if (le == 0) cycle
+               call locate(solver, le, ib, e)
+               solver%blocks(ib)%stress(e, :) = ic%stress(1:solver%ncomp)
+               solver%blocks(ib)%stress_global(e, :) = ic%stress(1:solver%ncomp)
+            end do
+          end associate
+       end do
+    end if
+    if (allocated(m%initial_fields)) then
+       ! Element value = mean of its nodes' values (nodes without a value count as 0).
+       do ib = 1, solver%n_blocks
+          associate (blk => solver%blocks(ib))
+            if (blk%nfieldv < 1 .or. .not. m%materials(blk%material)%user_field) cycle
+            do e = 1, blk%count
+               g = part%elem_global(blk%first + e - 1)
+               blk%field(e, 1) = mean_initial_field(m, g)
+            end do
+          end associate
+       end do
+    end if
+  end subroutine setup_solver
+
+  subroutine setup_block(m, part, solver, blk, modulus, user_field_active)
+    type(model_t), intent(in) :: m
+    type(partition_t), intent(in) :: part
+    type(solver_t), intent(in) :: solver
+    type(element_block_t), intent(inout) :: blk
+    real(dp), intent(in) :: modulus
+    logical, intent(in) :: user_field_active
+    integer :: nb, nd, ne, e, a, i
+    real(dp), allocatable :: xe(:, :, :)
+
+    nb = blk%count
+    nd = solver%ndim
+    ne = solver%nen
+    associate (mat => m%materials(blk%material))
+      blk%nstatev = max(1, mat%nstatev)
+      blk%nfieldv = max(1, mat%nfieldv)
+      allocate(blk%elem_number(nb), blk%thickness(nb), blk%volume_ref(nb), blk%bmat_ref(nb, nd, ne))
+      allocate(blk%mass(nb), blk%rotation(nb, nd, nd), blk%hourglass(nb, nd, solver%nmode))
+      allocate(blk%stress(nb, solver%ncomp), blk%stress_global(nb, solver%ncomp))
+      allocate(blk%state(nb, blk%nstatev), blk%field(nb, blk%nfieldv), blk%e_int(nb), blk%e_inel(nb))
+      ! LE is kept only where a VUSDFLD will ask for it.
+      if (user_field_active .and. mat%user_field) then
+         allocate(blk%log_strain(nb, solver%ncomp))
+      else
+         allocate(blk%log_strain(0, solver%ncomp))
+      end if
+      blk%log_strain = 0
+      allocate(xe(nb, nd, ne))
+      do e = 1, nb
+         blk%elem_number(e) = m%mesh%elem_id(part%elem_global(blk%first + e - 1))
+      end do
+      do a = 1, ne
+         do i = 1, nd
+            do e = 1, nb
+               xe(e, i, a) = solver%x0(i, part%conn(a, blk%first + e - 1))
+            end do
+         end do
+      end do
+      blk%thickness = m%sections(blk%section)%thickness
+      if (m%mesh%element_type == element_cpe4r) then
+         call cpe4r_geometry(nb, xe, blk%thickness, blk%volume_ref, blk%bmat_ref)
+      else
+         call c3d8r_geometry(nb, xe, blk%volume_ref, blk%bmat_ref)
+      end if
+      blk%mass = mat%density * blk%volume_ref
+      call identity_rotation(nb, nd, blk%rotation)
+      blk%hourglass = 0
+      blk%stress = 0
+      blk%stress_global = 0
+      blk%state = 0
+      blk%field = 0
+      blk%e_int = 0
+      blk%e_inel = 0
+      blk%wave_modulus = modulus
+    end associate
+  end subroutine setup_block
+
+  !> Internal forces of the current global stresses on the reference configuration: the
+  !> forces at t = 0 (initial stresses), before any increment.
+  subroutine initial_internal_forces(m, solver)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(inout) :: solver
+    integer :: ib, nb
+
+    do ib = 1, solver%n_blocks
+       associate (blk => solver%blocks(ib))
+         nb = blk%count
+         if (m%mesh%element_type == element_cpe4r) then
+            call cpe4r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, &
+                 solver%fe(blk%first:blk%first + nb - 1, :, :))
+         else
+            call c3d8r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, &
+                 solver%fe(blk%first:blk%first + nb - 1, :, :))
+         end if
+       end associate
+    end do
+    call assemble_element_vectors(solver%part, solver%ndim, solver%fe, solver%f_int)
+  end subroutine initial_internal_forces
+
+  !> Block and position of local element le.
+  pure subroutine locate(solver, le, ib, e)
+    type(solver_t), intent(in) :: solver
+    integer, intent(in) :: le
+    integer, intent(out) :: ib, e
+
+    do ib = 1, solver%n_blocks
+       if (le >= solver%blocks(ib)%first .and. le < solver%blocks(ib)%first + solver%blocks(ib)%count) then
+          e = le - solver%blocks(ib)%first + 1
+          return
+       end if
+    end do
+    ib = 1
+    e = 1
+  end subroutine locate
+
+  real(dp) function mean_initial_field(m, g)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: g
+    integer :: a, j, i
+    real(dp) :: total
+
+    total = 0
+    do a = 1, m%mesh%nen
+       do j = 1, size(m%initial_fields)
+          if (m%initial_fields(j)%variable /= 1) cycle
+          do i = 1, size(m%initial_fields(j)%nodes)
+             if (m%initial_fields(j)%nodes(i) == m%mesh%conn(a, g)) total = total + m%initial_fields(j)%value
+          end do
+       end do
+    end do
+    mean_initial_field = total / m%mesh%nen
+  end function mean_initial_field
+end module driver_setup

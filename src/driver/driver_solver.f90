@@ -1,0 +1,120 @@
+!> The solver's state on one rank: nodal arrays of the local nodes, element blocks of the
+!> local elements, rigid-body motion, energies and time. Built from the model and the
+!> partition before the first increment.
+!>
+!> Element blocks: consecutive local elements (ascending global order, which the deterministic
+!> assembly relies on) with the same section, at most `block_size` long. Every per-element array
+!> of a block is stored (element, component), so a block's stress is exactly the
+!> `(nblock, ncomp)` array a VUMAT receives: no copies on the way in or out.
+module driver_solver
+  use material_kinds, only: dp
+  use model, only: model_t
+  use model_mesh, only: element_cpe4r
+  use parallel_partition, only: partition_t
+  implicit none
+  private
+
+  integer, parameter, public :: block_size = 256
+
+  type, public :: element_block_t
+     integer :: first = 0, count = 0                  !< local elements first..first+count-1
+     integer :: material = 0, section = 0
+     integer :: nstatev = 0, nfieldv = 0              !< as the VUMAT sees them (>= 1 for storage)
+     integer, allocatable :: elem_number(:)           !< user element numbers (jblock(5:))
+     real(dp), allocatable :: thickness(:)            !< plane strain thickness
+     real(dp), allocatable :: volume_ref(:)
+     real(dp), allocatable :: bmat_ref(:, :, :)       !< (count, ndim, nen) reference mean gradient
+     real(dp), allocatable :: mass(:)                 !< element mass ρ0 V0
+     real(dp), allocatable :: rotation(:, :, :)       !< (count, ndim, ndim) R at t_n
+     real(dp), allocatable :: hourglass(:, :, :)      !< (count, ndim, nmode) stiffness-form state
+     real(dp), allocatable :: stress(:, :)            !< corotational Cauchy stress at t_n
+     real(dp), allocatable :: stress_global(:, :)     !< global stress at t_n (output, forces)
+     real(dp), allocatable :: state(:, :)             !< (count, nstatev) SDVs at t_n
+     real(dp), allocatable :: field(:, :)             !< (count, nfieldv) field variables at t_n
+     real(dp), allocatable :: e_int(:), e_inel(:)     !< specific energies (per unit mass)
+     real(dp), allocatable :: log_strain(:, :)        !< accumulated corotational strain (LE)
+     real(dp) :: wave_modulus = 0                     !< λ + 2G from the packaging call
+  end type element_block_t
+
+  type, public :: rigid_body_t
+     real(dp) :: u(3) = 0, v(3) = 0                   !< reference node displacement, velocity
+  end type rigid_body_t
+
+  type, public :: energies_t
+     real(dp) :: kinetic = 0, internal = 0, viscous = 0, friction = 0, external = 0, artificial = 0
+  end type energies_t
+
+  type, public :: solver_t
+     integer :: ndim = 0, nen = 0, ncomp = 0, nshr = 0, nmode = 0
+     type(partition_t) :: part
+     integer :: n_nodes = 0                           !< local nodes
+     real(dp), allocatable :: x0(:, :), u(:, :), v(:, :), a(:, :)   !< (ndim, n_nodes)
+     real(dp), allocatable :: mass(:)
+     real(dp), allocatable :: f_int(:, :), f_ext(:, :), f_contact(:, :), reaction(:, :)
+     logical, allocatable :: fixed(:, :)              !< (ndim, n_nodes) dof prescribed this step
+     real(dp), allocatable :: du(:, :), f_ext_old(:, :), reaction_old(:, :)  !< increment work arrays
+     real(dp), allocatable :: fe(:, :, :)             !< (n_local_elems, ndim, nen) element forces
+     integer :: n_blocks = 0
+     type(element_block_t), allocatable :: blocks(:)
+     type(rigid_body_t), allocatable :: rigid(:)      !< one per rigid surface
+     real(dp), allocatable :: wall_force(:, :)        !< (ndim, n_rigid) force on each wall (global)
+     ! Energies accumulated by this rank (element and owned-node shares); sums are global.
+     real(dp) :: e_viscous = 0, e_artificial = 0, e_friction = 0, e_external = 0
+     type(energies_t) :: energies                     !< global values at the last history point
+     ! Time
+     integer :: step = 0                              !< current step (1-based)
+     integer :: increment = 0                         !< increments since the start of the run
+     integer :: step_increment = 0
+     real(dp) :: total_time = 0, step_time = 0, step_start = 0
+     real(dp) :: dt = 0, dt_prev = 0                  !< dt_{n+1/2}, dt_{n-1/2}
+     real(dp) :: dt_stable = 0                        !< stable increment at t_n (before scaling)
+     integer :: dt_element = 0                        !< user number of the controlling element
+     ! Output schedule carried through a restart (driver_checkpoint -> driver_run).
+     real(dp) :: restart_next_field = 0, restart_next_history = 0, restart_energy_reference = 0
+  end type solver_t
+
+  public :: build_blocks
+
+contains
+
+  !> Split the local elements into blocks of one section and at most block_size elements.
+  subroutine build_blocks(m, part, solver)
+    type(model_t), intent(in) :: m
+    type(partition_t), intent(in) :: part
+    type(solver_t), intent(inout) :: solver
+    integer :: e, first, n, nblk, sec
+    integer, allocatable :: starts(:), counts(:)
+
+    allocate(starts(max(1, part%n_local_elems)), counts(max(1, part%n_local_elems)))
+    nblk = 0
+    e = 1
+    do while (e <= part%n_local_elems)
+       first = e
+       sec = m%mesh%elem_section(part%elem_global(e))
+       n = 1
+       do while (first + n <= part%n_local_elems .and. n < block_size)
+          if (m%mesh%elem_section(part%elem_global(first + n)) /= sec) exit
+          n = n + 1
+       end do
+       nblk = nblk + 1
+       starts(nblk) = first
+       counts(nblk) = n
+       e = first + n
+    end do
+    solver%n_blocks = nblk
+    allocate(solver%blocks(nblk))
+    do e = 1, nblk
+       solver%blocks(e)%first = starts(e)
+       solver%blocks(e)%count = counts(e)
+       solver%blocks(e)%section = m%mesh%elem_section(part%elem_global(starts(e)))
+       solver%blocks(e)%material = m%sections(solver%blocks(e)%section)%material
+    end do
+    solver%ndim = m%mesh%ndim
+    solver%nen = m%mesh%nen
+    if (m%mesh%element_type == element_cpe4r) then
+       solver%ncomp = 4; solver%nshr = 1; solver%nmode = 1
+    else
+       solver%ncomp = 6; solver%nshr = 3; solver%nmode = 4
+    end if
+  end subroutine build_blocks
+end module driver_solver

@@ -1,0 +1,137 @@
+!> The solver's side of the VUMAT/VUSDFLD door for element blocks.
+!>
+!> vumat and vusdfld are called through implicit interfaces, exactly as Abaqus calls user code,
+!> so a user's subroutine file links in place of ours. The first argument of vumat is
+!> jblock = [nblock, npt, layer, kspt, noel(1:nblock)] so both the scalar-nblock and the
+!> "jblock" styles of VUMAT work (reference/abaqus_interfaces.md §0). Times passed are those at
+!> the end of the increment; the packaging call has stepTime = totalTime = 0.
+!> With a user field, vusdfld runs first on the same block with the start-of-increment stress
+!> and logarithmic strain available to vgetvrm; its fields become the vumat's fieldNew and its
+!> state the vumat's stateOld.
+module driver_vumat_call
+  use material_kinds, only: dp
+  use abaqus_host, only: host_set_block
+  use model_materials, only: material_t
+  implicit none
+  private
+
+  external :: vumat, vusdfld
+
+  !> Arguments of a vumat call that the solver does not keep between increments.
+  type, public :: vumat_work_t
+     integer, allocatable :: jblock(:)
+     real(dp), allocatable :: coord(:, :), temp(:), stretch_old(:, :), stretch_new(:, :)
+     real(dp), allocatable :: defgrad_old(:, :), defgrad_new(:, :), field_new(:, :)
+     real(dp), allocatable :: stress_new(:, :), state_mid(:, :), state_new(:, :)
+     real(dp), allocatable :: e_int_new(:), e_inel_new(:), density(:), direct(:, :, :)
+  end type vumat_work_t
+
+  public :: vumat_work_init, call_material, packaging_modulus
+
+contains
+
+  subroutine vumat_work_init(w, nmax, ncomp, nshr, nstatev, nfieldv)
+    type(vumat_work_t), intent(inout) :: w
+    integer, intent(in) :: nmax, ncomp, nshr, nstatev, nfieldv
+    integer :: k
+
+    if (allocated(w%jblock)) deallocate(w%jblock, w%coord, w%temp, w%stretch_old, w%stretch_new, &
+         w%defgrad_old, w%defgrad_new, w%field_new, w%stress_new, w%state_mid, w%state_new, &
+         w%e_int_new, w%e_inel_new, w%density, w%direct)
+    allocate(w%jblock(4 + nmax), w%coord(nmax, 3), w%temp(nmax))
+    allocate(w%stretch_old(nmax, ncomp), w%stretch_new(nmax, ncomp))
+    allocate(w%defgrad_old(nmax, ncomp + nshr), w%defgrad_new(nmax, ncomp + nshr))
+    allocate(w%field_new(nmax, max(1, nfieldv)), w%stress_new(nmax, ncomp))
+    allocate(w%state_mid(nmax, max(1, nstatev)), w%state_new(nmax, max(1, nstatev)))
+    allocate(w%e_int_new(nmax), w%e_inel_new(nmax), w%density(nmax), w%direct(nmax, 3, 3))
+    w%jblock = 1
+    w%coord = 0
+    w%temp = 0
+    w%direct = 0
+    do k = 1, 3
+       w%direct(:, k, k) = 1
+    end do
+  end subroutine vumat_work_init
+
+  !> One increment of the material of a block: [vusdfld] then vumat. Arrays are the block's
+  !> (nb, ...) arrays; on return stress/state/field/energies hold the new values.
+  subroutine call_material(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, &
+       char_length, density, strain_inc, rel_spin, stretch_old, stretch_new, defgrad_old, &
+       defgrad_new, log_strain, stress, state, field, e_int, e_inel, w)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: nb, ncomp, nshr
+    integer, intent(in) :: elem_number(nb)
+    real(dp), intent(in) :: step_time, total_time, dt
+    real(dp), intent(in) :: char_length(nb), density(nb), strain_inc(nb, ncomp), rel_spin(nb, nshr)
+    real(dp), intent(in) :: stretch_old(nb, ncomp), stretch_new(nb, ncomp)
+    real(dp), intent(in) :: defgrad_old(nb, ncomp + nshr), defgrad_new(nb, ncomp + nshr)
+    real(dp), intent(in) :: log_strain(:, :)
+    real(dp), intent(inout) :: stress(nb, ncomp), state(:, :), field(:, :)
+    real(dp), intent(inout) :: e_int(nb), e_inel(nb)
+    type(vumat_work_t), intent(inout) :: w
+    integer :: nstatev, nfieldv, nprops
+
+    nstatev = mat%nstatev
+    nfieldv = mat%nfieldv
+    nprops = size(mat%props)
+    w%jblock(1:4) = [nb, 1, 1, 1]
+    w%jblock(5:4 + nb) = elem_number
+    if (mat%user_field) then
+       call host_set_block(nb, ncomp, stress, log_strain(1:nb, :))
+       w%field_new(1:nb, 1:nfieldv) = field(1:nb, 1:nfieldv)
+       call vusdfld(nb, nstatev, nfieldv, nprops, 3, nshr, elem_number, 1, 1, 1, step_time, total_time, &
+            dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), char_length, &
+            mat%props, state(1:nb, 1:max(1, nstatev)), w%state_mid(1:nb, 1:max(1, nstatev)), &
+            w%field_new(1:nb, 1:nfieldv))
+    else
+       w%state_mid(1:nb, 1:max(1, nstatev)) = state(1:nb, 1:max(1, nstatev))
+       w%field_new(1:nb, :) = field(1:nb, :)
+    end if
+    call vumat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
+         mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
+         w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, :), stress, w%state_mid(1:nb, :), &
+         e_int, e_inel, w%temp(1:nb), stretch_new, defgrad_new, w%field_new(1:nb, :), &
+         w%stress_new(1:nb, :), w%state_new(1:nb, :), w%e_int_new(1:nb), w%e_inel_new(1:nb))
+    stress = w%stress_new(1:nb, :)
+    state(1:nb, :) = w%state_new(1:nb, :)
+    field(1:nb, :) = w%field_new(1:nb, :)
+    e_int = w%e_int_new(1:nb)
+    e_inel = w%e_inel_new(1:nb)
+  end subroutine call_material
+
+  !> Abaqus's packaging call: a tiny uniaxial strain increment from a stress-free state at
+  !> stepTime = totalTime = 0; Δσ11/Δε11 is the P-wave modulus λ + 2G that sets the wave
+  !> speed for the stable increment, hourglass and bulk viscosity.
+  function packaging_modulus(mat, ncomp, nshr) result(modulus)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: ncomp, nshr
+    real(dp) :: modulus
+    real(dp), parameter :: probe = 1.0e-6_dp
+    real(dp) :: strain(1, ncomp), spin(1, nshr), stretch(1, ncomp), defgrad(1, ncomp + nshr)
+    real(dp) :: stress_old(1, ncomp), stress_new(1, ncomp), state_old(1, max(1, mat%nstatev))
+    real(dp) :: state_new(1, max(1, mat%nstatev)), field(1, max(1, mat%nfieldv))
+    real(dp) :: coord(1, 3), scalar1(1), e_old(1), e_new(1), ei_new(1), density(1)
+    integer :: jblock(5)
+
+    strain = 0
+    strain(1, 1) = probe
+    spin = 0
+    stretch = 0
+    stretch(1, 1:3) = 1
+    defgrad = 0
+    defgrad(1, 1:3) = 1
+    stress_old = 0
+    state_old = 0
+    field = 0
+    coord = 0
+    scalar1 = 0
+    e_old = 0
+    density = mat%density
+    jblock = [1, 1, 1, 1, 1]
+    call vumat(jblock, 3, nshr, mat%nstatev, mat%nfieldv, size(mat%props), 0, 0.0_dp, 0.0_dp, 1.0_dp, &
+         mat%vumat_name, coord, [1.0_dp], mat%props, density, strain, spin, scalar1, stretch, defgrad, &
+         field, stress_old, state_old, e_old, e_old, scalar1, stretch, defgrad, field, stress_new, &
+         state_new, e_new, ei_new)
+    modulus = stress_new(1, 1) / probe
+  end function packaging_modulus
+end module driver_vumat_call

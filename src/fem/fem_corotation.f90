@@ -1,0 +1,371 @@
+!> Corotational (Green–Naghdi) frame of one-point elements, as Abaqus/Explicit gives it to a VUMAT.
+!>
+!> Why Green–Naghdi (polar decomposition of the element F) and not an integrated
+!> (Hughes–Winget) spin: the VUMAT contract is Green–Naghdi. Abaqus hands the VUMAT
+!> relSpinInc = ΔW − ΔΩ (zero by construction for a frame that spins with W), stretch U = RᵀF and
+!> F, all consistent with R from F = RU. R is recomputed from the total F every increment, so no
+!> rotation error accumulates: a rigid rotation by 90° in any number of steps gives R equal to the
+!> exact rotation to round-off, and an objective (frame-indifferent) stress update is automatic.
+!>
+!> Data layout (block of nb elements, element index first, as a VUMAT receives its arrays):
+!>   f, r          (nb, ndim, ndim)   f(:, i, j) = F_ij = ∂x_i/∂X_j, r(:, i, j) = R_ij
+!>   symmetric     (nb, ncomp)        2D: 11, 22, 33, 12 (ncomp 4); 3D: 11, 22, 33, 12, 23, 31
+!>   spin vectors  (nb, nshr)         2D: ω3 = W21; 3D: (ω1, ω2, ω3) = (W32, W13, W21)
+!> Plane strain (ndim 2): R is an in-plane rotation, R33 = 1, and the 33 component is untouched.
+module fem_corotation
+  use material_kinds, only: dp
+  implicit none
+  private
+
+  public :: deformation_gradient, polar_rotation, identity_rotation
+  public :: to_corotational, to_global, relative_spin
+  public :: vumat_defgrad, vumat_stretch, corotational_increment
+
+  !> Symmetric-tensor component k of the 3-D VUMAT order is the pair (sym_i(k), sym_j(k)).
+  integer, parameter :: sym_i(6) = [1, 2, 3, 1, 2, 3]
+  integer, parameter :: sym_j(6) = [1, 2, 3, 2, 3, 1]
+  !> Polar decomposition (3D): stop when every element's Newton update is below this (the
+  !> iterate is then orthogonal to ~1e-16 after the extra final step), or after max_newton.
+  real(dp), parameter :: newton_tolerance = 1.0e-10_dp
+  integer, parameter :: max_newton = 60
+
+contains
+
+  !> The whole corotational step of a block, in the order of abaqus_interfaces.md §1.4:
+  !> F_{n+½}, F_{n+1} from the reference mean gradient; R_{n+½}, R_{n+1} by polar
+  !> decomposition; strainInc = R_{n+½}ᵀ Δε R_{n+½}; relSpinInc. strain_inc, spin_inc: the
+  !> global increments of <el>_strain_increment. r_old = R_n (element state, identity at the
+  !> start); after the VUMAT the driver rotates the stress with r_new (to_global) and keeps
+  !> r_new as the next r_old. f_new feeds defgradNew/stretchNew (vumat_defgrad, vumat_stretch).
+  pure subroutine corotational_increment(nb, ndim, nen, bmat_ref, xe_mid, xe_new, strain_inc, &
+                                         spin_inc, r_old, r_mid, r_new, f_new, strain_inc_corot, &
+                                         rel_spin)
+    integer, intent(in) :: nb, ndim, nen
+    real(dp), intent(in) :: bmat_ref(nb, ndim, nen)
+    real(dp), intent(in) :: xe_mid(nb, ndim, nen), xe_new(nb, ndim, nen)
+    real(dp), intent(in) :: strain_inc(nb, 2 * ndim), spin_inc(nb, 2 * ndim - 3)
+    real(dp), intent(in) :: r_old(nb, ndim, ndim)
+    real(dp), intent(out) :: r_mid(nb, ndim, ndim), r_new(nb, ndim, ndim), f_new(nb, ndim, ndim)
+    real(dp), intent(out) :: strain_inc_corot(nb, 2 * ndim), rel_spin(nb, 2 * ndim - 3)
+    real(dp) :: f_mid(nb, ndim, ndim)
+
+    call deformation_gradient(nb, ndim, nen, bmat_ref, xe_mid, f_mid)
+    call polar_rotation(nb, ndim, f_mid, r_mid)
+    call deformation_gradient(nb, ndim, nen, bmat_ref, xe_new, f_new)
+    call polar_rotation(nb, ndim, f_new, r_new)
+    call to_corotational(nb, ndim, 2 * ndim, r_mid, strain_inc, strain_inc_corot)
+    call relative_spin(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
+  end subroutine corotational_increment
+
+  !> Mean deformation gradient F = Σ_I x_I ⊗ B0_I of a block, B0 the mean gradient of the
+  !> reference configuration (fem_cpe4r/fem_c3d8r geometry on x0). Exact for linear fields.
+  !> Coordinates are taken relative to node 1 (Σ_I B0_I = 0), so large absolute coordinates do
+  !> not cost digits.
+  pure subroutine deformation_gradient(nb, ndim, nen, bmat_ref, xe, f)
+    integer, intent(in) :: nb, ndim, nen
+    real(dp), intent(in) :: bmat_ref(nb, ndim, nen)
+    real(dp), intent(in) :: xe(nb, ndim, nen)
+    real(dp), intent(out) :: f(nb, ndim, ndim)
+    integer :: i, j, n, e
+
+    f = 0.0_dp
+    do n = 2, nen
+       do j = 1, ndim
+          do i = 1, ndim
+             do e = 1, nb
+                f(e, i, j) = f(e, i, j) + (xe(e, i, n) - xe(e, i, 1)) * bmat_ref(e, j, n)
+             end do
+          end do
+       end do
+    end do
+  end subroutine deformation_gradient
+
+  !> R of the polar decomposition F = R U.
+  !> 2D: closed form, R = rotation by θ = atan2(F21 − F12, F11 + F22) (valid for det F > 0).
+  !> 3D: Newton iteration X ← ½(γX + X⁻ᵀ/γ) with Frobenius scaling γ = (‖X⁻¹‖/‖X‖)^½ (Higham),
+  !> which converges for any non-singular F (a few iterations for moderate stretches, ≲ 10 for
+  !> condition numbers up to 1e12). The exit test is block-wide, so the element loop stays
+  !> branch-free. An inverted element (det F < 0) gives an improper orthogonal matrix; the
+  !> inversion check (fem_inversion) stops such a run anyway.
+  pure subroutine polar_rotation(nb, ndim, f, r)
+    integer, intent(in) :: nb, ndim
+    real(dp), intent(in) :: f(nb, ndim, ndim)
+    real(dp), intent(out) :: r(nb, ndim, ndim)
+    real(dp) :: c(nb), s(nb), nrm(nb)
+
+    if (ndim == 2) then
+       c = f(:, 1, 1) + f(:, 2, 2)
+       s = f(:, 2, 1) - f(:, 1, 2)
+       ! ‖·‖² = ‖F‖² + 2 det F > 0 for a non-inverted element; the guard only avoids 0/0.
+       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
+       r(:, 1, 1) = c / nrm
+       r(:, 2, 1) = s / nrm
+       r(:, 1, 2) = -s / nrm
+       r(:, 2, 2) = c / nrm
+    else
+       call polar_rotation_3d(nb, f, r)
+    end if
+  end subroutine polar_rotation
+
+  pure subroutine polar_rotation_3d(nb, f, r)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: f(nb, 3, 3)
+    real(dp), intent(out) :: r(nb, 3, 3)
+    real(dp) :: cof(nb, 3, 3), det(nb), gam(nb), xnorm2(nb), cnorm2(nb), change(nb)
+    real(dp) :: xnew
+    integer :: it, i, j, e
+    logical :: scaled
+
+    r = f
+    scaled = .true.
+    do it = 1, max_newton
+       call cofactor(nb, r, cof, det)
+       ! Guard against an exactly singular (collapsed) element: no division by zero.
+       det = sign(max(abs(det), tiny(1.0_dp)), det)
+       if (scaled) then
+          xnorm2 = 0.0_dp
+          cnorm2 = 0.0_dp
+          do j = 1, 3
+             do i = 1, 3
+                xnorm2 = xnorm2 + r(:, i, j)**2
+                cnorm2 = cnorm2 + cof(:, i, j)**2
+             end do
+          end do
+          ! γ = (‖X⁻¹‖_F / ‖X‖_F)^½ with ‖X⁻¹‖_F = ‖cof X‖_F / |det X|
+          gam = sqrt(sqrt(cnorm2 / max(xnorm2, tiny(1.0_dp))) / abs(det))
+       else
+          gam = 1.0_dp
+       end if
+       change = 0.0_dp
+       do j = 1, 3
+          do i = 1, 3
+             do e = 1, nb
+                ! X⁻ᵀ = cof(X) / det X
+                xnew = 0.5_dp * (gam(e) * r(e, i, j) + cof(e, i, j) / (gam(e) * det(e)))
+                change(e) = change(e) + (xnew - r(e, i, j))**2
+                r(e, i, j) = xnew
+             end do
+          end do
+       end do
+       if (.not. scaled) exit
+       ! Near convergence the scaling is switched off for one last plain Newton step, which
+       ! restores full quadratic convergence to an orthogonal matrix.
+       if (maxval(change) <= newton_tolerance**2) scaled = .false.
+    end do
+  end subroutine polar_rotation_3d
+
+  !> Cofactor matrix (cof X)_ij = ∂det X/∂X_ij and det X of a block of 3×3 matrices.
+  pure subroutine cofactor(nb, x, cof, det)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: x(nb, 3, 3)
+    real(dp), intent(out) :: cof(nb, 3, 3), det(nb)
+
+    cof(:, 1, 1) = x(:, 2, 2) * x(:, 3, 3) - x(:, 2, 3) * x(:, 3, 2)
+    cof(:, 1, 2) = x(:, 2, 3) * x(:, 3, 1) - x(:, 2, 1) * x(:, 3, 3)
+    cof(:, 1, 3) = x(:, 2, 1) * x(:, 3, 2) - x(:, 2, 2) * x(:, 3, 1)
+    cof(:, 2, 1) = x(:, 1, 3) * x(:, 3, 2) - x(:, 1, 2) * x(:, 3, 3)
+    cof(:, 2, 2) = x(:, 1, 1) * x(:, 3, 3) - x(:, 1, 3) * x(:, 3, 1)
+    cof(:, 2, 3) = x(:, 1, 2) * x(:, 3, 1) - x(:, 1, 1) * x(:, 3, 2)
+    cof(:, 3, 1) = x(:, 1, 2) * x(:, 2, 3) - x(:, 1, 3) * x(:, 2, 2)
+    cof(:, 3, 2) = x(:, 1, 3) * x(:, 2, 1) - x(:, 1, 1) * x(:, 2, 3)
+    cof(:, 3, 3) = x(:, 1, 1) * x(:, 2, 2) - x(:, 1, 2) * x(:, 2, 1)
+    det = x(:, 1, 1) * cof(:, 1, 1) + x(:, 1, 2) * cof(:, 1, 2) + x(:, 1, 3) * cof(:, 1, 3)
+  end subroutine cofactor
+
+  !> R = I for every element (initial rotation state when the initial configuration is the
+  !> reference one).
+  pure subroutine identity_rotation(nb, ndim, r)
+    integer, intent(in) :: nb, ndim
+    real(dp), intent(out) :: r(nb, ndim, ndim)
+    integer :: i
+
+    r = 0.0_dp
+    do i = 1, ndim
+       r(:, i, i) = 1.0_dp
+    end do
+  end subroutine identity_rotation
+
+  !> a_c = Rᵀ a R: global → corotational components of a symmetric tensor (strain increment with
+  !> R = R_{n+½}; an initial global stress with R = R_n).
+  pure subroutine to_corotational(nb, ndim, ncomp, r, a, a_corot)
+    integer, intent(in) :: nb, ndim, ncomp
+    real(dp), intent(in) :: r(nb, ndim, ndim)
+    real(dp), intent(in) :: a(nb, ncomp)
+    real(dp), intent(out) :: a_corot(nb, ncomp)
+
+    call rotate_symmetric(nb, ndim, ncomp, r, .true., a, a_corot)
+  end subroutine to_corotational
+
+  !> a = R a_c Rᵀ: corotational → global components (stress for the nodal forces, R = R_{n+1}).
+  pure subroutine to_global(nb, ndim, ncomp, r, a_corot, a)
+    integer, intent(in) :: nb, ndim, ncomp
+    real(dp), intent(in) :: r(nb, ndim, ndim)
+    real(dp), intent(in) :: a_corot(nb, ncomp)
+    real(dp), intent(out) :: a(nb, ncomp)
+
+    call rotate_symmetric(nb, ndim, ncomp, r, .false., a_corot, a)
+  end subroutine to_global
+
+  !> transposed: b = Rᵀ a R, else b = R a Rᵀ. Works on the full in-plane (2D) or 3×3 matrix;
+  !> in 2D the 33 component is copied (R33 = 1).
+  pure subroutine rotate_symmetric(nb, ndim, ncomp, r, transposed, a, b)
+    integer, intent(in) :: nb, ndim, ncomp
+    real(dp), intent(in) :: r(nb, ndim, ndim)
+    logical, intent(in) :: transposed
+    real(dp), intent(in) :: a(nb, ncomp)
+    real(dp), intent(out) :: b(nb, ncomp)
+    real(dp) :: full(nb, ndim, ndim), t(nb, ndim, ndim), q(nb, ndim, ndim)
+    integer :: i, j, k, c
+
+    ! q = R (b = q a qᵀ) or Rᵀ
+    if (transposed) then
+       do j = 1, ndim
+          do i = 1, ndim
+             q(:, i, j) = r(:, j, i)
+          end do
+       end do
+    else
+       q = r
+    end if
+    if (ndim == 2) then
+       full(:, 1, 1) = a(:, 1)
+       full(:, 2, 2) = a(:, 2)
+       full(:, 1, 2) = a(:, 4)
+       full(:, 2, 1) = a(:, 4)
+    else
+       do c = 1, 6
+          full(:, sym_i(c), sym_j(c)) = a(:, c)
+          full(:, sym_j(c), sym_i(c)) = a(:, c)
+       end do
+    end if
+    ! t = a qᵀ, then b = q t
+    t = 0.0_dp
+    do j = 1, ndim
+       do k = 1, ndim
+          do i = 1, ndim
+             t(:, i, j) = t(:, i, j) + full(:, i, k) * q(:, j, k)
+          end do
+       end do
+    end do
+    full = 0.0_dp
+    do j = 1, ndim
+       do k = 1, ndim
+          do i = 1, ndim
+             full(:, i, j) = full(:, i, j) + q(:, i, k) * t(:, k, j)
+          end do
+       end do
+    end do
+    if (ndim == 2) then
+       b(:, 1) = full(:, 1, 1)
+       b(:, 2) = full(:, 2, 2)
+       b(:, 3) = a(:, 3)
+       ! symmetrised: exact symmetry of the result whatever the round-off
+       b(:, 4) = 0.5_dp * (full(:, 1, 2) + full(:, 2, 1))
+    else
+       do c = 1, 3
+          b(:, c) = full(:, c, c)
+       end do
+       do c = 4, 6
+          b(:, c) = 0.5_dp * (full(:, sym_i(c), sym_j(c)) + full(:, sym_j(c), sym_i(c)))
+       end do
+    end if
+  end subroutine rotate_symmetric
+
+  !> relSpinInc: ΔW − ΔΩ in the corotational frame (Rᵀ_{n+½} applied to the axial vector).
+  !> spin_inc is the global material spin increment of the element kinematics (axial vector of
+  !> skw(∂Δu/∂x_{n+½})); ΔΩ is the frame spin increment, the Cayley (midpoint) vector of
+  !> ΔR = R_{n+1} R_nᵀ: ω_Ω = 2 axial(ΔR − ΔRᵀ) / (1 + tr ΔR) = 2 tan(Δφ/2) a. The same midpoint
+  !> rule gives ΔW for a rigid rotation (∂Δu/∂x_{n+½} = 2(ΔR − I)(ΔR + I)⁻¹), so a rigid rotation
+  !> has relSpinInc = 0 to round-off.
+  !> Order (nb, nshr): 2D ω3 (about the out-of-plane axis); 3D (ω1, ω2, ω3) = (W32, W13, W21).
+  pure subroutine relative_spin(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
+    integer, intent(in) :: nb, ndim
+    real(dp), intent(in) :: spin_inc(nb, 2 * ndim - 3)
+    real(dp), intent(in) :: r_old(nb, ndim, ndim), r_new(nb, ndim, ndim), r_mid(nb, ndim, ndim)
+    real(dp), intent(out) :: rel_spin(nb, 2 * ndim - 3)
+    real(dp) :: dr(nb, ndim, ndim), w(nb, 3), trace1(nb)
+    integer :: i, j, k
+
+    ! ΔR_ij = Σ_k Rnew_ik Rold_jk
+    dr = 0.0_dp
+    do j = 1, ndim
+       do k = 1, ndim
+          do i = 1, ndim
+             dr(:, i, j) = dr(:, i, j) + r_new(:, i, k) * r_old(:, j, k)
+          end do
+       end do
+    end do
+    if (ndim == 2) then
+       ! 1 + tr ΔR of the 3-D embedding (ΔR33 = 1)
+       trace1 = 2.0_dp + dr(:, 1, 1) + dr(:, 2, 2)
+       rel_spin(:, 1) = spin_inc(:, 1) - 2.0_dp * (dr(:, 2, 1) - dr(:, 1, 2)) / trace1
+    else
+       trace1 = 1.0_dp + dr(:, 1, 1) + dr(:, 2, 2) + dr(:, 3, 3)
+       w(:, 1) = spin_inc(:, 1) - 2.0_dp * (dr(:, 3, 2) - dr(:, 2, 3)) / trace1
+       w(:, 2) = spin_inc(:, 2) - 2.0_dp * (dr(:, 1, 3) - dr(:, 3, 1)) / trace1
+       w(:, 3) = spin_inc(:, 3) - 2.0_dp * (dr(:, 2, 1) - dr(:, 1, 2)) / trace1
+       ! axial vectors transform as vectors under proper rotations: ω_c = Rᵀ ω
+       do i = 1, 3
+          rel_spin(:, i) = r_mid(:, 1, i) * w(:, 1) + r_mid(:, 2, i) * w(:, 2) &
+                           + r_mid(:, 3, i) * w(:, 3)
+       end do
+    end if
+  end subroutine relative_spin
+
+  !> F in the VUMAT layout (nb, ndir + 2 nshr): 2D F11, F22, F33 (= 1), F12, F21;
+  !> 3D F11, F22, F33, F12, F23, F31, F21, F32, F13.
+  pure subroutine vumat_defgrad(nb, ndim, f, defgrad)
+    integer, intent(in) :: nb, ndim
+    real(dp), intent(in) :: f(nb, ndim, ndim)
+    real(dp), intent(out) :: defgrad(nb, 4 * ndim - 3)
+
+    if (ndim == 2) then
+       defgrad(:, 1) = f(:, 1, 1)
+       defgrad(:, 2) = f(:, 2, 2)
+       defgrad(:, 3) = 1.0_dp
+       defgrad(:, 4) = f(:, 1, 2)
+       defgrad(:, 5) = f(:, 2, 1)
+    else
+       defgrad(:, 1) = f(:, 1, 1)
+       defgrad(:, 2) = f(:, 2, 2)
+       defgrad(:, 3) = f(:, 3, 3)
+       defgrad(:, 4) = f(:, 1, 2)
+       defgrad(:, 5) = f(:, 2, 3)
+       defgrad(:, 6) = f(:, 3, 1)
+       defgrad(:, 7) = f(:, 2, 1)
+       defgrad(:, 8) = f(:, 3, 2)
+       defgrad(:, 9) = f(:, 1, 3)
+    end if
+  end subroutine vumat_defgrad
+
+  !> Right stretch U = Rᵀ F (symmetrised) in the VUMAT layout (nb, ncomp); 2D U33 = 1.
+  pure subroutine vumat_stretch(nb, ndim, r, f, stretch)
+    integer, intent(in) :: nb, ndim
+    real(dp), intent(in) :: r(nb, ndim, ndim), f(nb, ndim, ndim)
+    real(dp), intent(out) :: stretch(nb, 2 * ndim)
+    real(dp) :: u(nb, ndim, ndim)
+    integer :: i, j, k, c
+
+    u = 0.0_dp
+    do j = 1, ndim
+       do k = 1, ndim
+          do i = 1, ndim
+             u(:, i, j) = u(:, i, j) + r(:, k, i) * f(:, k, j)
+          end do
+       end do
+    end do
+    if (ndim == 2) then
+       stretch(:, 1) = u(:, 1, 1)
+       stretch(:, 2) = u(:, 2, 2)
+       stretch(:, 3) = 1.0_dp
+       stretch(:, 4) = 0.5_dp * (u(:, 1, 2) + u(:, 2, 1))
+    else
+       do c = 1, 3
+          stretch(:, c) = u(:, c, c)
+       end do
+       do c = 4, 6
+          stretch(:, c) = 0.5_dp * (u(:, sym_i(c), sym_j(c)) + u(:, sym_j(c), sym_i(c)))
+       end do
+    end if
+  end subroutine vumat_stretch
+end module fem_corotation

@@ -1,0 +1,101 @@
+!> The scene reader: an Abaqus-syntax input file (with bulkflow's few extensions, see
+!> docs/keywords.md) -> a complete, validated `model_t` (docs/solver_interfaces.md §2).
+!>
+!> Everything is checked here, before the first increment; the first problem found ends
+!> the reading with `file:line: what is wrong; expected ...` in `err`. The passes:
+!> keywords and their places (scene_layout), mesh, sets, materials, sections, amplitudes,
+!> interactions, surfaces and rigid bodies, initial conditions, steps.
+module scene_reader
+  use error_report, only: error_t
+  use keyword_reader, only: keyword_deck_t, read_keyword_file
+  use model, only: model_t
+  use scene_layout, only: scene_layout_t, scan_layout
+  use scene_mesh, only: mesh_sources_t, build_mesh
+  use scene_sets, only: build_sets
+  use scene_materials, only: build_materials
+  use scene_sections, only: build_sections
+  use scene_amplitudes, only: build_amplitudes
+  use scene_interactions, only: build_interactions
+  use scene_surfaces, only: build_surfaces, build_rigid_bodies
+  use scene_initial, only: build_initial_conditions
+  use scene_steps, only: build_steps
+  implicit none
+  private
+
+  public :: read_scene
+
+contains
+
+  !> Parse, build and validate the scene in `path`.
+  !> `user_subroutine`: a user's VUMAT is compiled in, so *USER MATERIAL names are not
+  !> checked against ours (default .false.: our VUMATs only).
+  subroutine read_scene(path, model, err, user_subroutine)
+    character(len=*), intent(in) :: path
+    type(model_t), intent(out) :: model
+    type(error_t), intent(out) :: err
+    logical, intent(in), optional :: user_subroutine
+    type(keyword_deck_t) :: deck
+    type(scene_layout_t) :: layout
+    type(mesh_sources_t) :: sources
+    logical :: user
+
+    user = .false.
+    if (present(user_subroutine)) user = user_subroutine
+    model%input_file = path
+    call read_keyword_file(path, deck, err)
+    if (err%raised) return
+    if (deck%n_blocks == 0) then
+       err%raised = .true.
+       err%file = path
+       err%line = 0
+       err%message = trim(path) // ': the scene is empty; expected Abaqus keywords (*NODE, ' // &
+            '*ELEMENT, *MATERIAL, *STEP, ...)'
+       return
+    end if
+    call scan_layout(deck, layout, err)
+    if (err%raised) return
+    call read_heading(deck, model, err)
+    if (err%raised) return
+    allocate (model%nsets(0), model%elsets(0))
+    call build_mesh(deck, layout, model, sources, err)
+    if (err%raised) return
+    call build_sets(deck, layout, model, err)
+    if (err%raised) return
+    call build_materials(deck, layout, model, user, err)
+    if (err%raised) return
+    call build_sections(deck, layout, sources, model, err)
+    if (err%raised) return
+    call build_amplitudes(deck, model, err)
+    if (err%raised) return
+    call build_interactions(deck, layout, model, err)
+    if (err%raised) return
+    call build_surfaces(deck, layout, model, err)
+    if (err%raised) return
+    call build_rigid_bodies(deck, layout, model, err)
+    if (err%raised) return
+    call build_initial_conditions(deck, layout, model, err)
+    if (err%raised) return
+    call build_steps(deck, layout, model, err)
+  end subroutine read_scene
+
+  !> *HEADING: its first data line is the title (one *HEADING at most).
+  subroutine read_heading(deck, model, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(model_t), intent(inout) :: model
+    type(error_t), intent(inout) :: err
+    integer :: i, seen
+
+    seen = 0
+    do i = 1, deck%n_blocks
+       if (deck%blocks(i)%name /= 'HEADING') cycle
+       call deck%blocks(i)%check_params([character(len=8) ::], err)
+       if (err%raised) return
+       if (seen /= 0) then
+          call deck%blocks(i)%fail('second *HEADING; expected one *HEADING per scene', err)
+          return
+       end if
+       seen = i
+       if (deck%blocks(i)%n_lines > 0) model%heading = deck%blocks(i)%lines(1)%text
+    end do
+  end subroutine read_heading
+end module scene_reader

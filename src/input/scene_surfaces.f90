@@ -1,0 +1,382 @@
+!> Surfaces and rigid bodies of a scene.
+!>
+!> * *SURFACE, TYPE=ELEMENT (Abaqus's default): element or element set, face S1..S4 (CPE4R)
+!>   or S1..S6 (C3D8R), with Abaqus's face numbering; the face nodes are collected.
+!> * *SURFACE, TYPE=SEGMENTS (2D analytic rigid surface): START, x, y then LINE, x, y and
+!>   CIRCL, x, y, xc, yc (end point and centre; the arc is the one under 180 degrees).
+!> * *SURFACE, TYPE=PLANE (bulkflow's, 3D analytic rigid surface): a point line x, y, z and
+!>   a normal line nx, ny, nz; the material lies on the side the normal points to.
+!> * *RIGID BODY, REF NODE=..., ANALYTICAL SURFACE=...: the surface moves with that node.
+!>
+!> Element and rigid surfaces share one namespace, as in Abaqus.
+module scene_surfaces
+  use material_kinds, only: dp
+  use error_report, only: error_t, raise_error
+  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_text
+  use model, only: model_t
+  use model_sets, only: find_set, name_length
+  use model_surfaces, only: element_surface_t, rigid_surface_t, segment_t, segment_line, segment_arc
+  use scene_layout, only: scene_layout_t
+  use scene_sets, only: elem_targets
+  use scene_util, only: itoa, rtoa, get_real, field_name, expect_fields, expect_lines, &
+       append_int, sort_unique, sort_permutation, check_name
+  implicit none
+  private
+
+  public :: build_surfaces, build_rigid_bodies, find_element_surface, find_rigid_surface
+
+  !> Abaqus face numbering: local nodes of face S1..S4 of CPE4R and S1..S6 of C3D8R.
+  integer, parameter :: cpe4r_faces(2, 4) = reshape([1, 2, 2, 3, 3, 4, 4, 1], [2, 4])
+  integer, parameter :: c3d8r_faces(4, 6) = reshape([1, 2, 3, 4, 5, 8, 7, 6, 1, 5, 6, 2, &
+       2, 6, 7, 3, 3, 7, 8, 4, 4, 8, 5, 1], [4, 6])
+
+  !> Relative tolerance on the two radii of a CIRCL segment (coordinates typed with a
+  !> few digits, e.g. 0.7071 for sqrt(1/2), must pass).
+  real(dp), parameter :: radius_tolerance = 1.0e-4_dp
+
+contains
+
+  pure integer function find_element_surface(model, name)
+    type(model_t), intent(in) :: model
+    character(len=*), intent(in) :: name
+    integer :: k
+
+    find_element_surface = 0
+    do k = 1, model%n_element_surfaces
+       if (model%element_surfaces(k)%name == name) then
+          find_element_surface = k
+          return
+       end if
+    end do
+  end function find_element_surface
+
+  pure integer function find_rigid_surface(model, name)
+    type(model_t), intent(in) :: model
+    character(len=*), intent(in) :: name
+    integer :: k
+
+    find_rigid_surface = 0
+    do k = 1, model%n_rigid_surfaces
+       if (model%rigid_surfaces(k)%name == name) then
+          find_rigid_surface = k
+          return
+       end if
+    end do
+  end function find_rigid_surface
+
+  subroutine build_surfaces(deck, layout, model, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(scene_layout_t), intent(in) :: layout
+    type(model_t), intent(inout) :: model
+    type(error_t), intent(inout) :: err
+    type(element_surface_t), allocatable :: etmp(:)
+    type(rigid_surface_t), allocatable :: rtmp(:)
+    character(len=:), allocatable :: name, stype
+    integer :: i
+
+    allocate (model%element_surfaces(0), model%rigid_surfaces(0))
+    model%n_element_surfaces = 0
+    model%n_rigid_surfaces = 0
+    do i = 1, deck%n_blocks
+       if (layout%step_of(i) /= 0 .or. deck%blocks(i)%name /= 'SURFACE') cycle
+       associate (blk => deck%blocks(i))
+         call blk%check_params([character(len=8) :: 'NAME', 'TYPE', 'INTERNAL'], err)
+         if (err%raised) return
+         call blk%get_string('NAME', name, err)
+         if (.not. err%raised) call blk%get_string('TYPE', stype, err, default='ELEMENT', &
+              choices=[character(len=8) :: 'ELEMENT', 'SEGMENTS', 'PLANE'])
+         if (.not. err%raised) call check_name(blk, 'surface', name, name_length, err)
+         if (err%raised) return
+         if (find_element_surface(model, name) /= 0 .or. find_rigid_surface(model, name) /= 0) then
+            call blk%fail('surface ' // name // ' defined twice; expected unique surface names', err)
+            return
+         end if
+         if (stype == 'ELEMENT') then
+            allocate (etmp(model%n_element_surfaces + 1))
+            etmp(1:model%n_element_surfaces) = model%element_surfaces
+            call move_alloc(etmp, model%element_surfaces)
+            model%n_element_surfaces = model%n_element_surfaces + 1
+            model%element_surfaces(model%n_element_surfaces)%name = name
+            call read_element_surface(blk, model, model%n_element_surfaces, err)
+         else
+            allocate (rtmp(model%n_rigid_surfaces + 1))
+            rtmp(1:model%n_rigid_surfaces) = model%rigid_surfaces
+            call move_alloc(rtmp, model%rigid_surfaces)
+            model%n_rigid_surfaces = model%n_rigid_surfaces + 1
+            associate (rs => model%rigid_surfaces(model%n_rigid_surfaces))
+              rs%name = name
+              rs%ndim = model%mesh%ndim
+              if (stype == 'SEGMENTS') then
+                 call read_segments(blk, model%mesh%ndim, rs, err)
+              else
+                 call read_plane(blk, model%mesh%ndim, rs, err)
+              end if
+            end associate
+         end if
+         if (err%raised) return
+       end associate
+    end do
+  end subroutine build_surfaces
+
+  subroutine read_element_surface(blk, model, ks, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(model_t), intent(inout) :: model
+    integer, intent(in) :: ks
+    type(error_t), intent(inout) :: err
+    integer, allocatable :: elems(:), faces(:), targets(:), nodes(:), keys(:), perm(:)
+    integer, allocatable :: ue(:), uf(:)
+    character(len=:), allocatable :: face
+    integer :: il, j, n, nn, nfaces, f, ios, k, nu, nen_face
+
+    nfaces = merge(4, 6, model%mesh%ndim == 2)
+    nen_face = merge(2, 4, model%mesh%ndim == 2)
+    call expect_lines(blk, 1, huge(1), 'element or element set, face S1..S' // itoa(nfaces), err)
+    if (err%raised) return
+    n = 0
+    nn = 0
+    do il = 1, blk%n_lines
+       associate (dl => blk%lines(il))
+         call expect_fields(blk, dl, 2, 2, 'element or element set, face S1..S' // itoa(nfaces), err)
+         if (err%raised) return
+         call elem_targets(model, dl, 1, targets, err)
+         if (err%raised) return
+         face = field_name(dl, 2)
+         f = 0
+         ios = 1
+         if (len(face) >= 2) then
+            if (face(1:1) == 'S' .and. is_integer_text(face(2:))) read (face(2:), *, iostat=ios) f
+         end if
+         if (ios /= 0 .or. f < 1 .or. f > nfaces) then
+            call raise_error(dl%file, dl%line, 'face "' // dl%field(2) // '" is not a face of ' // &
+                 trim(merge('CPE4R', 'C3D8R', nfaces == 4)) // '; expected S1..S' // itoa(nfaces), err)
+            return
+         end if
+         do j = 1, size(targets)
+            call append_int(elems, n, targets(j))
+            call append_int(faces, nn, f)
+         end do
+       end associate
+    end do
+    if (n == 0) then
+       call blk%fail('surface has no faces (its element sets are empty); expected at least ' // &
+            'one element face', err)
+       return
+    end if
+    ! distinct (element, face) pairs in element order
+    allocate (keys(n))
+    keys = (elems(1:n) - 1) * 8 + faces(1:n)
+    call sort_permutation(keys, perm)
+    allocate (ue(n), uf(n))
+    nu = 0
+    do j = 1, n
+       if (nu > 0) then
+          if (ue(nu) == elems(perm(j)) .and. uf(nu) == faces(perm(j))) cycle
+       end if
+       nu = nu + 1
+       ue(nu) = elems(perm(j))
+       uf(nu) = faces(perm(j))
+    end do
+    allocate (nodes(nu * nen_face))
+    do j = 1, nu
+       do k = 1, nen_face
+          if (nfaces == 4) then
+             nodes((j - 1) * nen_face + k) = model%mesh%conn(cpe4r_faces(k, uf(j)), ue(j))
+          else
+             nodes((j - 1) * nen_face + k) = model%mesh%conn(c3d8r_faces(k, uf(j)), ue(j))
+          end if
+       end do
+    end do
+    associate (s => model%element_surfaces(ks))
+      s%elems = ue(1:nu)
+      s%faces = uf(1:nu)
+      call sort_unique(nodes, s%nodes)
+    end associate
+  end subroutine read_element_surface
+
+  !> START / LINE / CIRCL chain of a 2D analytic rigid surface.
+  subroutine read_segments(blk, ndim, rs, err)
+    type(keyword_block_t), intent(in) :: blk
+    integer, intent(in) :: ndim
+    type(rigid_surface_t), intent(inout) :: rs
+    type(error_t), intent(inout) :: err
+    character(len=:), allocatable :: kind
+    real(dp) :: p(2), c(2), r0, r1, cross, dot
+    integer :: il, n
+
+    if (ndim /= 2) then
+       call blk%fail('*SURFACE, TYPE=SEGMENTS in a 3D model; expected TYPE=PLANE for a 3D wall', err)
+       return
+    end if
+    call expect_lines(blk, 2, huge(1), 'START, x, y then LINE, x, y or CIRCL, x, y, xc, yc lines', err)
+    if (err%raised) return
+    allocate (rs%segments(blk%n_lines - 1))
+    n = 0
+    do il = 1, blk%n_lines
+       associate (dl => blk%lines(il))
+         kind = field_name(dl, 1)
+         if (il == 1 .neqv. kind == 'START') then
+            call raise_error(dl%file, dl%line, 'segment "' // dl%field(1) // '" here; expected ' // &
+                 trim(merge('START, x, y as the first line     ', 'LINE or CIRCL after the START line', il == 1)), err)
+            return
+         end if
+         select case (kind)
+         case ('START', 'LINE')
+            call expect_fields(blk, dl, 3, 3, kind // ', x, y', err)
+         case ('CIRCL')
+            call expect_fields(blk, dl, 5, 5, 'CIRCL, x, y, xc, yc (end point, centre)', err)
+         case default
+            call raise_error(dl%file, dl%line, 'unknown segment type "' // dl%field(1) // &
+                 '"; expected START, LINE or CIRCL', err)
+         end select
+         if (err%raised) return
+         call get_real(dl, 2, p(1), err)
+         if (.not. err%raised) call get_real(dl, 3, p(2), err)
+         if (err%raised) return
+         if (kind == 'START') then
+            rs%point(1:2) = p
+            cycle
+         end if
+         n = n + 1
+         associate (seg => rs%segments(n))
+           if (n == 1) then
+              seg%p0 = rs%point(1:2)
+           else
+              seg%p0 = rs%segments(n - 1)%p1
+           end if
+           seg%p1 = p
+           if (.not. (norm2(seg%p1 - seg%p0) > 0)) then
+              call raise_error(dl%file, dl%line, 'segment of zero length (end point equals start); ' // &
+                   'expected a distinct end point', err)
+              return
+           end if
+           if (kind == 'LINE') then
+              seg%kind = segment_line
+              cycle
+           end if
+           seg%kind = segment_arc
+           call get_real(dl, 4, c(1), err)
+           if (.not. err%raised) call get_real(dl, 5, c(2), err)
+           if (err%raised) return
+           seg%centre = c
+           r0 = norm2(seg%p0 - c)
+           r1 = norm2(seg%p1 - c)
+           if (.not. (r0 > 0 .and. r1 > 0) .or. abs(r0 - r1) > radius_tolerance * max(r0, r1)) then
+              call raise_error(dl%file, dl%line, 'CIRCL start and end are not equidistant from the ' // &
+                   'centre (radii ' // rtoa(r0) // ' and ' // rtoa(r1) // &
+                   '); expected both points on one circle about (xc, yc)', err)
+              return
+           end if
+           cross = (seg%p0(1) - c(1)) * (seg%p1(2) - c(2)) - (seg%p0(2) - c(2)) * (seg%p1(1) - c(1))
+           dot = dot_product(seg%p0 - c, seg%p1 - c)
+           if (dot < 0 .and. abs(cross) <= 1.0e-9_dp * r0 * r1) then
+              call raise_error(dl%file, dl%line, 'CIRCL spans 180 degrees, so its direction is ' // &
+                   'ambiguous; expected an arc under 180 degrees (split it in two)', err)
+              return
+           end if
+         end associate
+       end associate
+    end do
+    rs%n_segments = n
+  end subroutine read_segments
+
+  !> bulkflow's TYPE=PLANE: point line, normal line.
+  subroutine read_plane(blk, ndim, rs, err)
+    type(keyword_block_t), intent(in) :: blk
+    integer, intent(in) :: ndim
+    type(rigid_surface_t), intent(inout) :: rs
+    type(error_t), intent(inout) :: err
+    real(dp) :: length
+    integer :: k
+
+    if (ndim /= 3) then
+       call blk%fail('*SURFACE, TYPE=PLANE in a 2D model; expected TYPE=SEGMENTS for a 2D wall', err)
+       return
+    end if
+    call expect_lines(blk, 2, 2, 'a point line x, y, z and a normal line nx, ny, nz', err)
+    if (err%raised) return
+    call expect_fields(blk, blk%lines(1), 3, 3, 'a point x, y, z', err)
+    if (.not. err%raised) call expect_fields(blk, blk%lines(2), 3, 3, 'a normal nx, ny, nz', err)
+    if (err%raised) return
+    do k = 1, 3
+       call get_real(blk%lines(1), k, rs%point(k), err)
+       if (.not. err%raised) call get_real(blk%lines(2), k, rs%normal(k), err)
+       if (err%raised) return
+    end do
+    length = norm2(rs%normal)
+    if (.not. (length > 0)) then
+       call raise_error(blk%lines(2)%file, blk%lines(2)%line, 'plane normal is zero; expected a ' // &
+            'non-zero normal nx, ny, nz', err)
+       return
+    end if
+    rs%normal = rs%normal / length
+    allocate (rs%segments(0))
+    rs%n_segments = 0
+  end subroutine read_plane
+
+  !> *RIGID BODY, REF NODE=node or one-node set, ANALYTICAL SURFACE=name.
+  subroutine build_rigid_bodies(deck, layout, model, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(scene_layout_t), intent(in) :: layout
+    type(model_t), intent(inout) :: model
+    type(error_t), intent(inout) :: err
+    character(len=:), allocatable :: ref, surface
+    logical, allocatable :: in_element(:)
+    integer :: i, k, node, id, ks
+
+    allocate (in_element(model%mesh%n_nodes))
+    in_element = .false.
+    do k = 1, model%mesh%n_elems
+       in_element(model%mesh%conn(:, k)) = .true.
+    end do
+    do i = 1, deck%n_blocks
+       if (layout%step_of(i) /= 0 .or. deck%blocks(i)%name /= 'RIGID BODY') cycle
+       associate (blk => deck%blocks(i))
+         call blk%check_params([character(len=18) :: 'REF NODE', 'ANALYTICAL SURFACE'], err)
+         if (.not. err%raised) call blk%get_string('REF NODE', ref, err)
+         if (.not. err%raised) call blk%get_string('ANALYTICAL SURFACE', surface, err)
+         if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
+         if (err%raised) return
+         node = 0
+         if (is_integer_text(ref)) then
+            read (ref, *) id
+            node = model%mesh%node_index(id)
+            if (node == 0) then
+               call blk%fail('reference node ' // ref // ' is not defined; expected a node given ' // &
+                    'in *NODE', err)
+               return
+            end if
+         else
+            k = find_set(model%nsets, model%n_nsets, ref)
+            if (k == 0) then
+               call blk%fail('node set ' // ref // ' is not defined; expected a node number or a ' // &
+                    'one-node *NSET', err)
+               return
+            end if
+            if (size(model%nsets(k)%members) /= 1) then
+               call blk%fail('node set ' // ref // ' has ' // itoa(size(model%nsets(k)%members)) // &
+                    ' nodes; expected exactly one reference node', err)
+               return
+            end if
+            node = model%nsets(k)%members(1)
+         end if
+         if (in_element(node)) then
+            call blk%fail('reference node ' // itoa(model%mesh%node_id(node)) // ' belongs to an ' // &
+                 'element; expected a separate node for the rigid body', err)
+            return
+         end if
+         ks = find_rigid_surface(model, surface)
+         if (ks == 0) then
+            call blk%fail('analytical surface ' // surface // ' is not defined; expected a *SURFACE ' // &
+                 'of TYPE=SEGMENTS or TYPE=PLANE', err)
+            return
+         end if
+         if (model%rigid_surfaces(ks)%ref_node /= 0) then
+            call blk%fail('surface ' // surface // ' already belongs to a rigid body; expected one ' // &
+                 '*RIGID BODY per analytical surface', err)
+            return
+         end if
+         model%rigid_surfaces(ks)%ref_node = node
+       end associate
+    end do
+  end subroutine build_rigid_bodies
+end module scene_surfaces

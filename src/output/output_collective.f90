@@ -1,0 +1,48 @@
+!> Agreement on errors between the ranks of a communicator.
+!>
+!> The output routines are collective: when one rank finds a problem (a bad argument, a
+!> restart file that does not match) and returned alone, the others would wait forever in the
+!> next collective call. So every check ends with `agree_on_error`: all ranks learn whether
+!> any rank failed, and all receive the message of the lowest failing rank, so the caller
+!> sees the same error everywhere and can stop cleanly.
+module output_collective
+  use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Bcast, &
+       MPI_IN_PLACE, MPI_INTEGER, MPI_CHARACTER, MPI_MIN
+  implicit none
+  private
+
+  public :: agree_on_error
+
+contains
+
+  !> `failed` and `message` are this rank's; on return `any_failed` is the same on every rank
+  !> and, when true, `message` holds the lowest failing rank's message on every rank.
+  subroutine agree_on_error(comm, failed, message, any_failed)
+    type(MPI_Comm), intent(in) :: comm
+    logical, intent(in) :: failed
+    character(len=:), allocatable, intent(inout) :: message
+    logical, intent(out) :: any_failed
+    integer :: rank, nranks, first, n
+
+    call MPI_Comm_rank(comm, rank)
+    call MPI_Comm_size(comm, nranks)
+    first = nranks
+    if (failed) first = rank
+    call MPI_Allreduce(MPI_IN_PLACE, first, 1, MPI_INTEGER, MPI_MIN, comm)
+    any_failed = first < nranks
+    if (.not. any_failed) return
+
+    n = 0
+    if (rank == first) then
+       if (.not. allocated(message)) message = 'unspecified error'
+       n = len(message)
+    end if
+    call MPI_Bcast(n, 1, MPI_INTEGER, first, comm)
+    if (rank /= first) then
+       if (allocated(message)) deallocate (message)
+       allocate (character(len=n) :: message)
+    end if
+    if (n > 0) call MPI_Bcast(message, n, MPI_CHARACTER, first, comm)
+  end subroutine agree_on_error
+
+end module output_collective
