@@ -93,11 +93,12 @@ contains
     two_g = 2.0_dp * mc%shear
     vol_factor = lam / (3.0_dp * lam + 2.0_dp * mc%shear)
     ! Constant strength: filled once for every chunk.
-    phi = mc%phi
-    psi = mc%psi
-    sin_phi = sin(mc%phi)
-    sin_psi = sin(mc%psi)
-    cohesion = mc%cohesion
+    n = min(nblock, block_points)
+    phi(1:n) = mc%phi
+    psi(1:n) = mc%psi
+    sin_phi(1:n) = sin(mc%phi)
+    sin_psi(1:n) = sin(mc%psi)
+    cohesion(1:n) = mc%cohesion
 
     if (nstatev > n_state_plastic) state_new(:, n_state_plastic + 1:) = state_old(:, n_state_plastic + 1:)
     do k0 = 0, nblock - 1, block_points

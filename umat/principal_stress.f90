@@ -340,14 +340,36 @@ contains
     real(dp), intent(out) :: sig(block_points, 3)
     real(dp), intent(out) :: c(n), sn(n)
     integer, intent(out) :: izz(n)
-    real(dp) :: sa, sb, szz, cs, ss
-    integer(int64) :: above_a, above_b
+    real(dp), parameter :: up = 2.0_dp**600, down = 2.0_dp**(-600), t_floor = 2.0_dp**(-504)
+    real(dp) :: sa, sb, szz, mid, d, o, amax, f, g, rs, rho, t, inv
+    integer(int64) :: small, large, pos, above_a, above_b
     integer :: k
 
     do k = 1, n
-       call sym2_eigen_vec(s(k, 1), s(k, 2), s(k, 4), sa, sb, cs, ss)
-       c(k) = cs
-       sn(k) = ss
+       ! In-plane eigen-pair: the operations of sym2_eigen, without branch (see above); the
+       ! deviator is scaled by 2 (exact) or, outside [1e-150, 1e150], by 2^±600 (into
+       ! [1e-143, 1e128]); t_floor, below every non-zero t, makes a double root keep the axes.
+       mid = 0.5_dp * (s(k, 1) + s(k, 2))
+       d = 0.5_dp * (s(k, 1) - s(k, 2))
+       amax = max(abs(d), abs(s(k, 4)))
+       small = not(sign_mask(1.0e-150_dp - amax))     ! amax ≤ 1e-150
+       large = not(sign_mask(amax - 1.0e150_dp))      ! amax ≥ 1e150
+       f = bit_select(small, up, bit_select(large, down, 2.0_dp))
+       g = bit_select(small, down, bit_select(large, up, 0.5_dp))
+       t = abs(d) * f
+       o = s(k, 4) * f
+       rs = sqrt(t * t + o * o)
+       rho = rs * g
+       t = max(t + rs, t_floor)
+       sa = mid + rho
+       sb = mid - rho
+       inv = 1.0_dp / sqrt(t * t + o * o)
+       t = t * inv
+       o = o * inv
+       pos = not(sign_mask(d + 0.0_dp))               ! d ≥ 0 (−0 included)
+       c(k) = bit_select(pos, t, o)
+       sn(k) = bit_select(pos, o, t)
+
        szz = s(k, 3)
        ! szz ≥ sa, szz ≥ sb (the second follows from the first, sa ≥ sb).
        above_a = not(sign_mask(szz - sa))
@@ -409,13 +431,14 @@ contains
     real(dp), parameter :: f8 = -0.0006117952499170653_dp
     real(dp), parameter :: third = 1.0_dp / 3.0_dp
     real(dp), parameter :: scale_up = 2.0_dp**704, scale_down = 2.0_dp**(-678)
+    real(dp), parameter :: up2 = 2.0_dp**600, down2 = 2.0_dp**(-600), t_floor = 2.0_dp**(-504)
     real(dp) :: s1, s2, s3, s4, s5, s6, amax, sf, isf, q, b11, b22, b33, p2, p, ip
     real(dp) :: c11, c22, c33, c12, c23, c13, r, rho, rho2, rho4, mu, mm
     real(dp) :: x01_1, x01_2, x01_3, x02_1, x02_2, x02_3, x12_1, x12_2, x12_3, n01, n02, n12
     real(dp) :: x1, x2, x3, nx, u1, u2, u3, w1, w2, w3, v1, v2, v3, inv_x, inv_u
     real(dp) :: cu1, cu2, cu3, cw1, cw2, cw3, a11, a22, a12, mu_a, mu_b, cs, sn, mu_s
-    real(dp) :: ea1, ea2, ea3, eb1, eb2, eb3
-    integer(int64) :: small, large, iso, top, pick01, pick02, big, first
+    real(dp) :: ea1, ea2, ea3, eb1, eb2, eb3, mid, d, o, f, g, rs, t, inv
+    integer(int64) :: small, large, iso, top, pick01, pick02, big, first, pos
     integer :: k
 
     do k = 1, n
@@ -518,7 +541,28 @@ contains
        a22 = w1 * cw1 + w2 * cw2 + w3 * cw3
        a12 = u1 * cw1 + u2 * cw2 + u3 * cw3
        mu_s = (c11 + c22 + c33) - a11 - a22
-       call sym2_eigen_vec(a11, a22, a12, mu_a, mu_b, cs, sn)
+       ! 2x2 eigen-pair (the operations of sym2_eigen; written out, like the plane block's,
+       ! so that the loop body needs no call whatever the inliner decides).
+       mid = 0.5_dp * (a11 + a22)
+       d = 0.5_dp * (a11 - a22)
+       amax = max(abs(d), abs(a12))
+       small = not(sign_mask(1.0e-150_dp - amax))     ! amax ≤ 1e-150
+       large = not(sign_mask(amax - 1.0e150_dp))      ! amax ≥ 1e150
+       f = bit_select(small, up2, bit_select(large, down2, 2.0_dp))
+       g = bit_select(small, down2, bit_select(large, up2, 0.5_dp))
+       t = abs(d) * f
+       o = a12 * f
+       rs = sqrt(t * t + o * o)
+       rho = rs * g
+       t = max(t + rs, t_floor)
+       mu_a = mid + rho
+       mu_b = mid - rho
+       inv = 1.0_dp / sqrt(t * t + o * o)
+       t = t * inv
+       o = o * inv
+       pos = not(sign_mask(d + 0.0_dp))               ! d ≥ 0 (−0 included)
+       cs = bit_select(pos, t, o)
+       sn = bit_select(pos, o, t)
        ea1 = cs * u1 + sn * w1
        ea2 = cs * u2 + sn * w2
        ea3 = cs * u3 + sn * w3
@@ -574,42 +618,6 @@ contains
        s(k, 6) = a3 * vec(k, 1, 1) + b3 * vec(k, 1, 2) + c3 * vec(k, 1, 3)
     end do
   end subroutine rebuild_3d_block
-
-  !> sym2_eigen for the block loops: the same operations, no branch. Deviators outside
-  !> [1e-150, 1e150] are scaled by 2^600 or 2^-600 (into [1e-143, 1e128]) instead of an
-  !> exponent-dependent power of two, the others by 2 (exact: no result bit changes); a double
-  !> root (d = a12 = 0) keeps the current axes.
-  pure subroutine sym2_eigen_vec(a11, a22, a12, mu_a, mu_b, c, sn)
-    real(dp), intent(in) :: a11, a22, a12
-    real(dp), intent(out) :: mu_a, mu_b, c, sn
-    real(dp), parameter :: up = 2.0_dp**600, down = 2.0_dp**(-600)
-    !> Below every non-zero t (≥ 2e-143 after scaling); its square is a normal number, and a
-    !> power of two gives c = 1, sn = 0 exactly for a double root.
-    real(dp), parameter :: t_floor = 2.0_dp**(-504)
-    real(dp) :: mid, d, o, amax, f, g, rs, rho, t, inv
-    integer(int64) :: small, large, pos
-
-    mid = 0.5_dp * (a11 + a22)
-    d = 0.5_dp * (a11 - a22)
-    amax = max(abs(d), abs(a12))
-    small = not(sign_mask(1.0e-150_dp - amax))    ! amax ≤ 1e-150
-    large = not(sign_mask(amax - 1.0e150_dp))     ! amax ≥ 1e150
-    f = bit_select(small, up, bit_select(large, down, 2.0_dp))
-    g = bit_select(small, down, bit_select(large, up, 0.5_dp))
-    t = abs(d) * f
-    o = a12 * f
-    rs = sqrt(t * t + o * o)
-    rho = rs * g
-    t = max(t + rs, t_floor)
-    mu_a = mid + rho
-    mu_b = mid - rho
-    inv = 1.0_dp / sqrt(t * t + o * o)
-    t = t * inv
-    o = o * inv
-    pos = not(sign_mask(d + 0.0_dp))              ! d ≥ 0 (−0 included)
-    c = bit_select(pos, t, o)
-    sn = bit_select(pos, o, t)
-  end subroutine sym2_eigen_vec
 
   !> All ones where x has its sign bit set (x < 0 or x = −0), zeros elsewhere: with a
   !> difference a − b, which is +0 for a = b, it turns a comparison into a bit mask

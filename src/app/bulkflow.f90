@@ -10,7 +10,7 @@
 program bulkflow
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Abort, MPI_COMM_WORLD, MPI_Comm_rank, MPI_Comm_size
-  use error_report, only: error_t, fatal_error, set_final_stop
+  use error_report, only: error_t, set_final_stop
   use model, only: model_t
   use scene_reader, only: read_scene
   use driver_run, only: run_options_t, run_scene
@@ -34,7 +34,7 @@ program bulkflow
   call parse_arguments(scene, opts, check_only)
 
   call read_scene(scene, m, err)
-  if (err%raised) call fatal_error(err)
+  if (err%raised) call input_error_exit(err)
   if (check_only) then
      if (rank == 0) write (output_unit, '(a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (', &
           m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, ' elements, ', m%n_steps, ' steps)'
@@ -101,9 +101,18 @@ contains
             '[--restart] [--stop-after N] [--quiet]'
     end if
     call MPI_Finalize()
-    if (len(problem) > 0) error stop 2
+    if (len(problem) > 0) error stop 2, quiet=.true.
     stop
   end subroutine usage
+
+  !> Every rank reads the scene and finds the same problem: rank 0 says it once, all ranks
+  !> leave MPI cleanly, exit status 2 (no MPI_Abort noise, no backtrace).
+  subroutine input_error_exit(err)
+    type(error_t), intent(in) :: err
+    if (rank == 0) write (error_unit, '(a)') 'bulkflow: error: ' // err%message
+    call MPI_Finalize()
+    error stop 2, quiet=.true.
+  end subroutine input_error_exit
 
   subroutine abort_all()
     call MPI_Abort(MPI_COMM_WORLD, 2)

@@ -239,6 +239,11 @@ contains
           if (solver%fixed(j, i)) then
              solver%a(j, i) = 0
              solver%reaction(j, i) = solver%f_int(j, i) - solver%f_ext(j, i)
+          else if (solver%mass(i) <= 0) then
+             ! A node no element uses (a rigid body's reference node, held by rank 0) has no
+             ! mass and no forces: it does not move unless prescribed.
+             solver%a(j, i) = 0
+             solver%reaction(j, i) = 0
           else
              solver%a(j, i) = (solver%f_ext(j, i) - solver%f_int(j, i)) / solver%mass(i)
              solver%reaction(j, i) = 0

@@ -16,8 +16,8 @@
 !>
 !> Reading checks everything a wrong restart could get wrong (rank count, names, kinds,
 !> shapes, order, truncation) and fails with a message such as
-!>   restart file run.rst.1: expected real array "v" of shape (2,100), found real array "v"
-!>   of shape (2,99)
+!>   bulkflow: error: out/run.rst.1: expected real array "v" of shape (2,100), found real
+!>   array "v" of shape (2,99)
 !> All procedures are collective over `comm` (errors are agreed on: every rank gets the
 !> same error), except checkpoint_discard.
 module output_checkpoint
@@ -103,7 +103,7 @@ contains
     type(MPI_Comm), intent(in) :: comm
     type(checkpoint_header_t), intent(in) :: header
     type(error_t), intent(inout), optional :: err
-    character(len=:), allocatable :: msg
+    character(len=:), allocatable :: msg, file
     logical :: any_failed
 
     call MPI_Comm_rank(comm, ck%rank)
@@ -117,10 +117,10 @@ contains
        msg = 'cannot create ' // ck%tmp_path
        ck%unit = -1
     end if
-    call agree(ck, msg, any_failed)
+    call agree(ck, msg, any_failed, file)
     if (any_failed) then
        call checkpoint_discard(ck)
-       call raise_error('', 0, msg, err)
+       call raise_error(file, 0, msg, err)
        return
     end if
     ck%writing = .true.
@@ -135,28 +135,29 @@ contains
   subroutine checkpoint_end_write(ck, err)
     type(checkpoint_t), intent(inout) :: ck
     type(error_t), intent(inout), optional :: err
-    character(len=:), allocatable :: msg
+    character(len=:), allocatable :: msg, file
     logical :: any_failed, ok
     integer :: ios
 
-    if (.not. ck%writing) call raise_error('', 0, 'checkpoint_end_write: no checkpoint is being written')
+    if (.not. ck%writing) call raise_error('checkpoint_end_write', 0, &
+         'no checkpoint is being written')
     if (ck%ios == 0) write (ck%unit, iostat=ck%ios) tag_end
     close (ck%unit, iostat=ios)
     ck%unit = -1
     if (ck%ios == 0) ck%ios = ios
     if (ck%ios /= 0) msg = 'writing ' // ck%tmp_path // ' failed (disk full?); the previous ' // &
          'checkpoint is kept'
-    call agree(ck, msg, any_failed)
+    call agree(ck, msg, any_failed, file)
     if (any_failed) then
        call checkpoint_discard(ck)
-       call raise_error('', 0, msg, err)
+       call raise_error(file, 0, msg, err)
        return
     end if
     call rename_file(ck%tmp_path, ck%path, ok)
     if (.not. ok) msg = 'cannot rename ' // ck%tmp_path // ' to ' // ck%path
     ck%writing = .false.
-    call agree(ck, msg, any_failed)
-    if (any_failed) call raise_error('', 0, msg, err)
+    call agree(ck, msg, any_failed, file)
+    if (any_failed) call raise_error(file, 0, msg, err)
   end subroutine checkpoint_end_write
 
   !> Abandon a checkpoint being written: close and delete the temporary file, keep the
@@ -178,10 +179,10 @@ contains
     integer(int32), intent(in) :: kind
     integer, intent(in) :: shape(:)
 
-    if (.not. ck%writing) call raise_error('', 0, 'checkpoint_put "' // name // &
+    if (.not. ck%writing) call raise_error('checkpoint_put', 0, 'array "' // name // &
          '": no checkpoint is being written')
-    if (len(name) == 0 .or. len(name) > max_name_length) call raise_error('', 0, &
-         'checkpoint_put: array names must have 1 to ' // int_to_str(max_name_length) // ' characters')
+    if (len(name) == 0 .or. len(name) > max_name_length) call raise_error('checkpoint_put', 0, &
+         'array names must have 1 to ' // int_to_str(max_name_length) // ' characters')
     if (ck%ios /= 0) return
     write (ck%unit, iostat=ck%ios) tag_array, int(len(name), int32), name, kind, &
          int(size(shape), int32), int(shape, int64)
@@ -264,7 +265,7 @@ contains
     type(MPI_Comm), intent(in) :: comm
     type(checkpoint_header_t), intent(out) :: header
     type(error_t), intent(inout), optional :: err
-    character(len=:), allocatable :: msg
+    character(len=:), allocatable :: msg, file
     character(len=8) :: file_magic
     integer(int32) :: version, nranks, rank, step, increment, frames, rows
     integer :: ios, same(4)
@@ -308,19 +309,20 @@ contains
        header%history_rows = rows
        header%nranks = nranks
     end if
-    call agree(ck, msg, any_failed)
+    call agree(ck, msg, any_failed, file)
     if (.not. any_failed) then
        same = [header%step, -header%step, header%increment, -header%increment]
        call MPI_Allreduce(MPI_IN_PLACE, same, 4, MPI_INTEGER, MPI_MAX, comm)
        if (same(1) /= -same(2) .or. same(3) /= -same(4)) then
-          msg = 'restart files ' // base // '.rst.*: the ranks'' files are of different increments (' // &
+          file = base // '.rst.*'
+          msg = 'the ranks'' restart files are of different increments (' // &
                int_to_str(-same(4)) // ' to ' // int_to_str(same(3)) // &
                '): a checkpoint was interrupted while its files were being replaced'
           any_failed = .true.
        end if
     end if
     if (any_failed) then
-       call fail_read(ck, msg, err)
+       call fail_read(ck, file, msg, err)
        return
     end if
     ck%reading = .true.
@@ -330,13 +332,14 @@ contains
   subroutine checkpoint_end_read(ck, err)
     type(checkpoint_t), intent(inout) :: ck
     type(error_t), intent(inout), optional :: err
-    character(len=:), allocatable :: msg, found
+    character(len=:), allocatable :: msg, file, found
     integer(int32) :: tag
     integer :: ios
     logical :: any_failed
 
     if (ck%failed) return
-    if (.not. ck%reading) call raise_error('', 0, 'checkpoint_end_read: no checkpoint is being read')
+    if (.not. ck%reading) call raise_error('checkpoint_end_read', 0, &
+         'no checkpoint is being read')
     read (ck%unit, iostat=ios) tag
     if (ios /= 0) then
        msg = 'truncated file (no end mark)'
@@ -344,9 +347,9 @@ contains
        call read_description(ck, tag, found)
        msg = 'the file holds more arrays than this run reads; the next is ' // found
     end if
-    call agree(ck, msg, any_failed)
+    call agree(ck, msg, any_failed, file)
     if (any_failed) then
-       call fail_read(ck, msg, err)
+       call fail_read(ck, file, msg, err)
        return
     end if
     close (ck%unit, iostat=ios)
@@ -362,7 +365,7 @@ contains
     integer(int32), intent(in) :: kind
     integer, intent(in) :: shape(:)
     type(error_t), intent(inout), optional :: err
-    character(len=:), allocatable :: msg, found, file_name
+    character(len=:), allocatable :: msg, found, file_name, file
     integer(int32) :: tag, name_len, file_kind, file_rank
     integer(int64), allocatable :: file_shape(:)
     integer :: ios
@@ -370,7 +373,7 @@ contains
 
     ok = .false.
     if (ck%failed) return
-    if (.not. ck%reading) call raise_error('', 0, 'checkpoint_get "' // name // &
+    if (.not. ck%reading) call raise_error('checkpoint_get', 0, 'array "' // name // &
          '": no checkpoint is being read')
     read (ck%unit, iostat=ios) tag
     if (ios /= 0) then
@@ -402,9 +405,9 @@ contains
           end if
        end if
     end if
-    call agree(ck, msg, any_failed)
+    call agree(ck, msg, any_failed, file)
     if (any_failed) then
-       call fail_read(ck, msg, err)
+       call fail_read(ck, file, msg, err)
        return
     end if
     ok = .true.
@@ -416,12 +419,12 @@ contains
     character(len=*), intent(in) :: name
     integer, intent(in) :: ios
     type(error_t), intent(inout), optional :: err
-    character(len=:), allocatable :: msg
+    character(len=:), allocatable :: msg, file
     logical :: any_failed
 
     if (ios /= 0) msg = 'truncated file in the data of "' // name // '"'
-    call agree(ck, msg, any_failed)
-    if (any_failed) call fail_read(ck, msg, err)
+    call agree(ck, msg, any_failed, file)
+    if (any_failed) call fail_read(ck, file, msg, err)
   end subroutine check_data
 
   !> The description of a record the caller did not ask for (for checkpoint_end_read).
@@ -477,19 +480,21 @@ contains
     text = text // ')'
   end function describe
 
-  !> Agree on an error between the ranks; the message (prefixed with this rank's file name)
-  !> of the lowest failing rank goes to all.
-  subroutine agree(ck, msg, any_failed)
+  !> Agree on an error between the ranks; the message and file name of the lowest failing
+  !> rank go to all.
+  subroutine agree(ck, msg, any_failed, file)
     type(checkpoint_t), intent(in) :: ck
     character(len=:), allocatable, intent(inout) :: msg
     logical, intent(out) :: any_failed
+    character(len=:), allocatable, intent(out) :: file
 
-    if (allocated(msg)) msg = 'restart file ' // ck%path // ': ' // msg
-    call agree_on_error(ck%comm, allocated(msg), msg, any_failed)
+    file = ck%path
+    call agree_on_error(ck%comm, allocated(msg), msg, any_failed, file)
   end subroutine agree
 
-  subroutine fail_read(ck, msg, err)
+  subroutine fail_read(ck, file, msg, err)
     type(checkpoint_t), intent(inout) :: ck
+    character(len=*), intent(in) :: file
     character(len=*), intent(in) :: msg
     type(error_t), intent(inout), optional :: err
     integer :: ios
@@ -498,7 +503,7 @@ contains
     ck%unit = -1
     ck%failed = .true.
     ck%reading = .false.
-    call raise_error('', 0, msg, err)
+    call raise_error(file, 0, msg, err)
   end subroutine fail_read
 
   subroutine get_r0(ck, name, value, err)

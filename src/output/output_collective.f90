@@ -16,13 +16,15 @@ module output_collective
 contains
 
   !> `failed` and `message` are this rank's; on return `any_failed` is the same on every rank
-  !> and, when true, `message` holds the lowest failing rank's message on every rank.
-  subroutine agree_on_error(comm, failed, message, any_failed)
+  !> and, when true, `message` holds the lowest failing rank's message on every rank (and
+  !> `file`, when given, that rank's file name: ranks may have files of their own).
+  subroutine agree_on_error(comm, failed, message, any_failed, file)
     type(MPI_Comm), intent(in) :: comm
     logical, intent(in) :: failed
     character(len=:), allocatable, intent(inout) :: message
     logical, intent(out) :: any_failed
-    integer :: rank, nranks, first, n
+    character(len=:), allocatable, intent(inout), optional :: file
+    integer :: rank, nranks, first
 
     call MPI_Comm_rank(comm, rank)
     call MPI_Comm_size(comm, nranks)
@@ -32,17 +34,29 @@ contains
     any_failed = first < nranks
     if (.not. any_failed) return
 
-    n = 0
-    if (rank == first) then
-       if (.not. allocated(message)) message = 'unspecified error'
-       n = len(message)
+    if (rank == first .and. .not. allocated(message)) message = 'unspecified error'
+    call broadcast_text(message)
+    if (present(file)) then
+       if (rank == first .and. .not. allocated(file)) file = ''
+       call broadcast_text(file)
     end if
-    call MPI_Bcast(n, 1, MPI_INTEGER, first, comm)
-    if (rank /= first) then
-       if (allocated(message)) deallocate (message)
-       allocate (character(len=n) :: message)
-    end if
-    if (n > 0) call MPI_Bcast(message, n, MPI_CHARACTER, first, comm)
+
+  contains
+
+    subroutine broadcast_text(text)
+      character(len=:), allocatable, intent(inout) :: text
+      integer :: n
+
+      n = 0
+      if (rank == first) n = len(text)
+      call MPI_Bcast(n, 1, MPI_INTEGER, first, comm)
+      if (rank /= first) then
+         if (allocated(text)) deallocate (text)
+         allocate (character(len=n) :: text)
+      end if
+      if (n > 0) call MPI_Bcast(text, n, MPI_CHARACTER, first, comm)
+    end subroutine broadcast_text
+
   end subroutine agree_on_error
 
 end module output_collective

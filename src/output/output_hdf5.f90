@@ -50,6 +50,10 @@ module output_hdf5
   public :: field_writer_close, field_writer_frame_count
 
   integer, parameter :: format_version = 1
+  !> The file named in messages of failed HDF5 calls (set by each public procedure): such
+  !> failures are fatal, and the low-level helpers that detect them have no writer at hand.
+  character(len=:), allocatable :: error_context
+
   !> Dataset name reserved for the current coordinates of a frame.
   character(len=*), parameter :: coordinates_name = 'coordinates'
 
@@ -148,12 +152,11 @@ contains
     end if
     if (present(restart_frames)) then
        if (restart_frames < 0) call fail('restart_frames must not be negative')
-       if (.not. file_exists(w%h5_path)) &
-            call fail('cannot restart the field output: ' // w%h5_path // ' does not exist')
+       if (.not. file_exists(w%h5_path)) call fail('cannot restart: the file does not exist')
     end if
     call agree_on_error(comm, failed, msg, any_failed)
     if (any_failed) then
-       call raise_error('', 0, 'field output ' // w%h5_path // ': ' // msg, err)
+       call raise_error(w%h5_path, 0, msg, err)
        return
     end if
     ! Every node must have exactly one owner and every element one holder, else rows of the
@@ -161,12 +164,13 @@ contains
     counts = [count(node_owned), size(elem_global)]
     call MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_INTEGER, MPI_SUM, comm)
     if (counts(1) /= n_nodes .or. counts(2) /= n_elems) then
-       call raise_error('', 0, 'field output ' // w%h5_path // ': ranks own ' // &
+       call raise_error(w%h5_path, 0, 'the ranks own ' // &
             int_to_str(counts(1)) // ' nodes and hold ' // int_to_str(counts(2)) // &
             ' elements, expected ' // int_to_str(n_nodes) // ' and ' // int_to_str(n_elems), err)
        return
     end if
 
+    error_context = w%h5_path
     call h5open_f(hdferr)
     call check(hdferr, 'h5open')
     call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, hdferr)
@@ -198,7 +202,7 @@ contains
        call reopen_frames(w, restart_frames, msg)
        if (allocated(msg)) then
           call close_handles(w)
-          call raise_error('', 0, 'field output ' // w%h5_path // ': ' // msg, err)
+          call raise_error(w%h5_path, 0, msg, err)
           return
        end if
     else
@@ -314,7 +318,7 @@ contains
     if (.not. allocated(msg) .and. size(x, 1) /= w%ndim) msg = 'x must be (ndim, n_local)'
     call agree_on_error(w%comm, allocated(msg), msg, any_failed)
     if (any_failed) then
-       call raise_error('', 0, 'field output ' // w%h5_path // ', coordinates: ' // msg, err)
+       call raise_error(w%h5_path, 0, 'coordinates: ' // msg, err)
        return
     end if
     rows = pack(node_global, node_owned)
@@ -412,6 +416,7 @@ contains
     type(error_t), intent(inout), optional :: err
 
     if (.not. w%is_open) return
+    error_context = w%h5_path
     if (w%frame_open) call field_writer_end_frame(w, err)
     call close_handles(w)
   end subroutine field_writer_close
@@ -679,7 +684,7 @@ contains
        call xdmf_write(w%xmf_path, w%mesh, w%frames, n_done, ok)
     end if
     call MPI_Bcast(ok, 1, MPI_LOGICAL, 0, w%comm)
-    if (.not. ok) call raise_error('', 0, 'cannot write the XDMF file ' // w%xmf_path, err)
+    if (.not. ok) call raise_error(w%xmf_path, 0, 'cannot write the XDMF file', err)
   end subroutine rewrite_xdmf
 
   !> Problems with the node arguments of a field call on this rank (msg unallocated: none).
@@ -740,7 +745,7 @@ contains
        end if
     end if
     ok = .not. any_failed
-    if (.not. ok) call raise_error('', 0, 'field output ' // w%h5_path // ', field "' // &
+    if (.not. ok) call raise_error(w%h5_path, 0, 'field "' // &
          name // '": ' // msg, err)
   end function field_agreed
 
@@ -858,13 +863,13 @@ contains
        r = recv_rows(k) - first + 1
        ! block_rank sent every row to the block holding it, so r is in range; a row sent
        ! twice means two ranks claim the same node.
-       if (seen(r)) call raise_error('', 0, 'field output ' // w%h5_path // ': row ' // &
+       if (seen(r)) call raise_error(w%h5_path, 0, 'row ' // &
             int_to_str(recv_rows(k)) // ' is written by two ranks (node owned twice?)')
        seen(r) = .true.
        block(:, r) = recv_values(:, k)
     end do
-    if (.not. all(seen)) call raise_error('', 0, 'field output ' // w%h5_path // &
-         ': rows left unwritten (a node without owner?)')
+    if (.not. all(seen)) call raise_error(w%h5_path, 0, &
+         'rows left unwritten (a node without owner?)')
   end subroutine redistribute
 
   !> Collective write of the packed rows buf(ncomp, size(rows)) of a (nrows, ncomp)
@@ -1096,7 +1101,8 @@ contains
     type(field_writer_t), intent(in) :: w
     character(len=*), intent(in) :: what
 
-    if (.not. w%is_open) call raise_error('', 0, what // ': the field writer is not open')
+    if (.not. w%is_open) call raise_error(what, 0, 'the field writer is not open')
+    error_context = w%h5_path
   end subroutine require_open
 
   subroutine require_frame(w, what)
@@ -1104,7 +1110,7 @@ contains
     character(len=*), intent(in) :: what
 
     call require_open(w, what)
-    if (.not. w%frame_open) call raise_error('', 0, what // ': no frame is open ' // &
+    if (.not. w%frame_open) call raise_error(what, 0, 'no frame is open ' // &
          '(call field_writer_frame first)')
   end subroutine require_frame
 
@@ -1114,7 +1120,7 @@ contains
     integer, intent(in) :: hdferr
     character(len=*), intent(in) :: what
 
-    if (hdferr < 0) call raise_error('', 0, 'HDF5 field output: ' // what // ' failed')
+    if (hdferr < 0) call raise_error(error_context, 0, 'HDF5: ' // what // ' failed')
   end subroutine check
 
 end module output_hdf5

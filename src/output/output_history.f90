@@ -15,7 +15,7 @@
 !> All procedures may be called on every rank: with `comm` given, only its rank 0 touches
 !> the file; errors found on open are shared with all ranks.
 module output_history
-  use mpi_f08, only: MPI_Comm, MPI_Comm_rank
+  use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Bcast, MPI_INTEGER
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use output_files, only: rename_file, file_exists, int_to_str
@@ -96,6 +96,8 @@ contains
 
     if (present(comm)) then
        call agree_on_error(comm, allocated(msg), msg, any_failed)
+       ! The rows kept by a restart are known on rank 0 only.
+       if (.not. any_failed) call MPI_Bcast(h%rows, 1, MPI_INTEGER, 0, comm)
     else
        any_failed = allocated(msg)
     end if
@@ -103,7 +105,7 @@ contains
        if (h%writer .and. h%unit /= -1) close (h%unit, iostat=ios)
        h%unit = -1
        h%writer = .false.
-       call raise_error('', 0, 'history file ' // path // ': ' // msg, err)
+       call raise_error(path, 0, msg, err)
     end if
   end subroutine history_open
 
@@ -115,9 +117,11 @@ contains
     character(len=32) :: buf
     integer :: i, ios
 
+    ! Counted on every rank, so history_row_count can go into any rank's checkpoint.
+    h%rows = h%rows + 1
     if (.not. h%writer) return
-    if (size(values) /= h%n_columns) call raise_error('', 0, 'history file ' // h%path // &
-         ': a row of ' // int_to_str(size(values)) // ' values for ' // &
+    if (size(values) /= h%n_columns) call raise_error(h%path, 0, &
+         'a row of ' // int_to_str(size(values)) // ' values for ' // &
          int_to_str(h%n_columns) // ' columns')
     line = ''
     do i = 1, size(values)
@@ -126,9 +130,8 @@ contains
        line = line // trim(adjustl(buf))
     end do
     write (h%unit, '(a)', iostat=ios) line
-    if (ios /= 0) call raise_error('', 0, 'history file ' // h%path // ': write failed')
+    if (ios /= 0) call raise_error(h%path, 0, 'write failed')
     flush (h%unit)
-    h%rows = h%rows + 1
   end subroutine history_row
 
   subroutine history_close(h)
@@ -140,8 +143,8 @@ contains
     h%writer = .false.
   end subroutine history_close
 
-  !> Data rows in the file (header excluded); meaningful on the writing rank. A checkpoint
-  !> records it so that a restart can truncate exactly (history_open restart_rows).
+  !> Data rows in the file (header excluded), the same on every rank. A checkpoint records
+  !> it so that a restart can truncate exactly (history_open restart_rows).
   pure integer function history_row_count(h)
     type(history_t), intent(in) :: h
 

@@ -94,7 +94,7 @@ contains
     integer, intent(in) :: id
 
     call check_id(t, id, 'timer_start')
-    if (t%running(id)) call raise_error('', 0, 'timer_start: phase "' // trim(t%names(id)) // &
+    if (t%running(id)) call raise_error('timer_start', 0, 'phase "' // trim(t%names(id)) // &
          '" is already running')
     t%running(id) = .true.
     t%started(id) = clock()
@@ -107,7 +107,7 @@ contains
 
     now = clock()
     call check_id(t, id, 'timer_stop')
-    if (.not. t%running(id)) call raise_error('', 0, 'timer_stop: phase "' // &
+    if (.not. t%running(id)) call raise_error('timer_stop', 0, 'phase "' // &
          trim(t%names(id)) // '" is not running')
     t%running(id) = .false.
     t%seconds(id) = t%seconds(id) + seconds_between(t%started(id), now)
@@ -150,7 +150,7 @@ contains
        call MPI_Comm_size(comm, nranks)
        nmin = n
        call MPI_Allreduce(MPI_IN_PLACE, nmin, 1, MPI_INTEGER, MPI_MIN, comm)
-       if (nmin /= n) call raise_error('', 0, 'timer_report: ranks registered different phases')
+       if (nmin /= n) call raise_error('timer_report', 0, 'ranks registered different phases')
        call MPI_Allreduce(MPI_IN_PLACE, tmax, n + 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm)
        call MPI_Allreduce(MPI_IN_PLACE, tmean, n + 1, MPI_DOUBLE_PRECISION, MPI_SUM, comm)
        tmean = tmean / nranks
@@ -213,7 +213,7 @@ contains
     integer, intent(in) :: id
     character(len=*), intent(in) :: what
 
-    if (id < 1 .or. id > t%n) call raise_error('', 0, what // ': unknown timer id (register it first)')
+    if (id < 1 .or. id > t%n) call raise_error(what, 0, 'unknown timer id (register it first)')
   end subroutine check_id
 
   integer(int64) function clock()

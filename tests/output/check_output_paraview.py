@@ -16,6 +16,7 @@ from paraview import servermanager
 from paraview import simple
 from paraview.vtk.numpy_interface import dataset_adapter as dsa
 
+sys.dont_write_bytecode = True      # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from check_output_fields import expected_fields, frame_times, make_mesh  # noqa: E402
 

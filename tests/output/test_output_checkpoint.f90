@@ -164,7 +164,7 @@ contains
     ! Wrong name.
     call checkpoint_begin_read(ck, base, MPI_COMM_WORLD, h, err)
     call checkpoint_get(ck, 'x', s0, err)
-    call check_message(err%raised, err%message, 'restart file ' // base // '.rst.0: ' // &
+    call check_message(err%raised, err%message, base // '.rst.0: ' // &
          'expected real scalar "x", found real scalar "r0"', 'wrong name')
     ! Later calls after a failure do nothing (no cascade of errors).
     err = error_t()
@@ -178,7 +178,7 @@ contains
     call checkpoint_begin_read(ck, base, MPI_COMM_WORLD, h, err)
     call checkpoint_get(ck, 'r0', s0, err)
     call checkpoint_get(ck, 'r1', s1, err)
-    call check_message(err%raised, err%message, 'restart file ' // base // '.rst.0: ' // &
+    call check_message(err%raised, err%message, base // '.rst.0: ' // &
          'expected real array "r1" of shape (8), found real array "r1" of shape (7)', 'wrong shape')
 
     ! Wrong kind.

@@ -29,13 +29,14 @@ program test_output_history
   do i = 0, 5
      call history_row(h, row(i, 0.0_dp))
   end do
+  call check(history_row_count(h) == 6, 'row count on every rank')
   call history_close(h)
   call check_file(6, 6, 'first run')
 
   ! Restart at t = 0.2: rows after it go, new rows follow.
   call history_open(h, path, columns, MPI_COMM_WORLD, restart_time=2 * 0.1_dp, err=err)
   call check(.not. err%raised, 'restart by time')
-  if (rank == 0) call check(history_row_count(h) == 3, 'restart by time keeps 3 rows')
+  call check(history_row_count(h) == 3, 'restart by time keeps 3 rows (on every rank)')
   do i = 3, 5
      call history_row(h, row(i, 100.0_dp))
   end do

@@ -1,7 +1,8 @@
 !> Timing of partition_mesh and assemble_element_vectors (not a test).
-!>   mpiexec -n N bulkflow-bench-assembly [nx ny [repetitions]]     (default 200 100 500)
+!>   mpiexec -n N bulkflow-bench-assembly [nx ny [repetitions]]     (default 200 100 200)
 !> A 2D nx x ny quad mesh (scrambled numbering) and, with nx*ny elements too, a 3D hex mesh of
-!> about the same number of elements; ncomp = ndim. Prints the slowest rank's times.
+!> about the same number of elements; ncomp = ndim. Prints the slowest rank's times (assembly:
+!> the best of 5 batches of `repetitions` calls).
 program bench_parallel_assembly
   use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_Init, MPI_Finalize, MPI_Wtime
   use material_kinds, only: dp
@@ -21,7 +22,7 @@ program bench_parallel_assembly
   comm = MPI_COMM_WORLD
   nx = 200
   ny = 100
-  reps = 500
+  reps = 200
   if (command_argument_count() >= 2) then
      call get_command_argument(1, arg)
      read (arg, *) nx
@@ -47,8 +48,8 @@ contains
     type(mesh_t), intent(in) :: mesh
     type(partition_t) :: part
     real(dp), allocatable :: fe(:, :, :), f(:, :)
-    real(dp) :: t0, t_part, t_asm
-    integer :: r, le, c, a, ncomp
+    real(dp) :: t0, t_part, t_asm, t_batch
+    integer :: r, b, le, c, a, ncomp
     character(len=:), allocatable :: summary
 
     call comm_barrier(comm)
@@ -68,13 +69,18 @@ contains
        end do
     end do
     call assemble_element_vectors(part, ncomp, fe, f)     ! warm-up
-    call comm_barrier(comm)
-    t0 = MPI_Wtime()
-    do r = 1, reps
-       call assemble_element_vectors(part, ncomp, fe, f)
+    ! best of 5 batches: on a shared machine the minimum is the stable number
+    t_asm = huge(1.0_dp)
+    do b = 1, 5
+       call comm_barrier(comm)
+       t0 = MPI_Wtime()
+       do r = 1, reps
+          call assemble_element_vectors(part, ncomp, fe, f)
+       end do
+       t_batch = (MPI_Wtime() - t0) / reps
+       call comm_max(comm, t_batch)
+       t_asm = min(t_asm, t_batch)
     end do
-    t_asm = (MPI_Wtime() - t0) / reps
-    call comm_max(comm, t_asm)
     if (comm_rank(comm) == 0) then
        print '(a, i0, a, i0, a)', label // ': ', mesh%n_elems, ' elements, ', comm_size(comm), ' ranks'
        print '(a)', '  ' // summary

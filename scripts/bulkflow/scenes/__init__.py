@@ -1,0 +1,1 @@
+"""Parametric scene generators: they write plain Abaqus input files (.inp) for bulkflow."""

@@ -1,0 +1,554 @@
+#!/usr/bin/env python3
+"""Write the verification scenes of inputs/verification/ (issue 3 items 6-7).
+
+    .venv/bin/python scripts/make_verification_scenes.py [--out inputs/verification]
+
+Every scene is generated here so the meshes are reproducible; the generated .inp files are
+committed too. Each scene starts with `** verify:` comment lines holding the parameters its
+checker (tests/scenes/check_scene.py) needs: the checker reads them from the scene, so the
+closed forms always use the numbers the solver ran with. inputs/verification/README.md lists
+the scenes and their closed forms.
+
+Standard library only (the meshes are small and regular, or fixed patch geometries).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+# One elastic material for all scenes: E = 10 MPa, nu = 0.3, rho = 2000 kg/m^3:
+# M = E(1-nu)/((1+nu)(1-2nu)) = 13.46 MPa, c_d = sqrt(M/rho) = 82.04 m/s, K0 = nu/(1-nu) = 0.4286.
+RHO = 2000.0
+E = 1.0e7
+NU = 0.3
+G = 9.81
+
+
+def fmt(x: float) -> str:
+    """A real for a data line: full precision, always with a dot or exponent."""
+    text = repr(float(x))
+    return text
+
+
+class Scene:
+    """Accumulates the lines of one .inp file."""
+
+    def __init__(self, name: str, title: str, verify: dict[str, object], comment: list[str]):
+        self.name = name
+        self.lines: list[str] = []
+        for c in comment:
+            self.lines.append('** ' + c)
+        for key, value in verify.items():
+            self.lines.append(f'** verify: {key} = {value}')
+        self.lines.append('*HEADING')
+        self.lines.append(title)
+
+    def add(self, *lines: str) -> None:
+        self.lines.extend(lines)
+
+    def nodes(self, coords: dict[int, tuple[float, ...]], nset: str | None = None) -> None:
+        self.add('*NODE' + (f', NSET={nset}' if nset else ''))
+        for n in sorted(coords):
+            self.add(', '.join([str(n)] + [fmt(c) for c in coords[n]]))
+
+    def elements(self, etype: str, conn: dict[int, tuple[int, ...]], elset: str) -> None:
+        self.add(f'*ELEMENT, TYPE={etype}, ELSET={elset}')
+        for e in sorted(conn):
+            self.add(', '.join(str(v) for v in (e,) + tuple(conn[e])))
+
+    def nset(self, name: str, members: list[int]) -> None:
+        self.add(f'*NSET, NSET={name}')
+        members = sorted(set(members))
+        for i in range(0, len(members), 16):
+            self.add(', '.join(str(m) for m in members[i:i + 16]))
+
+    def elset(self, name: str, members: list[int]) -> None:
+        self.add(f'*ELSET, ELSET={name}')
+        members = sorted(set(members))
+        for i in range(0, len(members), 16):
+            self.add(', '.join(str(m) for m in members[i:i + 16]))
+
+    def elastic_material(self, elset: str, thickness: float | None = None, name: str = 'SOLID') -> None:
+        self.add(f'*SOLID SECTION, ELSET={elset}, MATERIAL={name}')
+        self.add(fmt(thickness) if thickness is not None else ',')
+        self.add(f'*MATERIAL, NAME={name}', '*DENSITY', fmt(RHO), '*ELASTIC', f'{fmt(E)}, {fmt(NU)}')
+
+    def write(self, folder: Path) -> Path:
+        path = folder / f'{self.name}.inp'
+        path.write_text('\n'.join(self.lines) + '\n')
+        return path
+
+
+# ---------------------------------------------------------------------------------------------
+# Structured meshes
+
+def grid_2d(nx: int, ny: int, lx: float, ly: float, origin=(0.0, 0.0), frame=((1.0, 0.0), (0.0, 1.0))):
+    """CPE4R grid; node (i, j) -> i + j (nx+1) + 1, element (i, j) -> i + j nx + 1, counter-clockwise.
+    frame: unit vectors of the local x and y axes (a rotation keeps the node order counter-clockwise)."""
+    (ax, ay), (bx, by) = frame
+    nodes = {}
+    for j in range(ny + 1):
+        for i in range(nx + 1):
+            xi, eta = lx * i / nx, ly * j / ny
+            nodes[i + j * (nx + 1) + 1] = (origin[0] + xi * ax + eta * bx, origin[1] + xi * ay + eta * by)
+    conn = {}
+    for j in range(ny):
+        for i in range(nx):
+            n1 = i + j * (nx + 1) + 1
+            conn[i + j * nx + 1] = (n1, n1 + 1, n1 + nx + 2, n1 + nx + 1)
+    return nodes, conn
+
+
+def node_2d(i: int, j: int, nx: int) -> int:
+    return i + j * (nx + 1) + 1
+
+
+def grid_3d(nx: int, ny: int, nz: int, lx: float, ly: float, lz: float, frame=None):
+    """C3D8R grid; node (i, j, k) -> i + j (nx+1) + k (nx+1)(ny+1) + 1; nodes 1-4 the bottom face
+    counter-clockwise seen from +z, 5-8 above. frame: local x, y, z unit vectors (right-handed)."""
+    if frame is None:
+        frame = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    nodes = {}
+    for k in range(nz + 1):
+        for j in range(ny + 1):
+            for i in range(nx + 1):
+                loc = (lx * i / nx, ly * j / ny, lz * k / nz)
+                nodes[node_3d(i, j, k, nx, ny)] = tuple(sum(loc[a] * frame[a][d] for a in range(3)) for d in range(3))
+    conn = {}
+    for k in range(nz):
+        for j in range(ny):
+            for i in range(nx):
+                b = [node_3d(i, j, k, nx, ny), node_3d(i + 1, j, k, nx, ny), node_3d(i + 1, j + 1, k, nx, ny),
+                     node_3d(i, j + 1, k, nx, ny)]
+                t = [n + (nx + 1) * (ny + 1) for n in b]
+                conn[i + j * nx + k * nx * ny + 1] = tuple(b + t)
+    return nodes, conn
+
+
+def node_3d(i: int, j: int, k: int, nx: int, ny: int) -> int:
+    return i + j * (nx + 1) + k * (nx + 1) * (ny + 1) + 1
+
+
+def wave_speed() -> float:
+    m = E * (1 - NU) / ((1 + NU) * (1 - 2 * NU))
+    return math.sqrt(m / RHO)
+
+
+# ---------------------------------------------------------------------------------------------
+# 1. Elastic wave in a bar
+
+def wave_bar_2d() -> Scene:
+    nx, ny, length, height, v0 = 200, 2, 1.0, 0.01, 0.5
+    c = wave_speed()
+    h = length / nx
+    period = 0.8 * length / c
+    stations = (0.2, 0.6)
+    s = Scene('wave_bar_2d', 'verification: 1D elastic wave in a plane-strain bar (CPE4R)',
+              {'kind': 'wave', 'ndim': 2, 'rho': RHO, 'E': E, 'nu': NU, 'v0': v0, 'length': length,
+               'stations': ' '.join(fmt(x) for x in stations), 'axis': 1},
+              ['Plane-strain strip, lateral rollers (u2 = 0 on top and bottom), far end fixed; the',
+               'end x = 0 is driven into the bar at v0 from t = 0: a compression front runs at',
+               'c_d = sqrt(M/rho) with sigma_11 = -rho c_d v0 and particle velocity v0 behind it.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes, conn = grid_2d(nx, ny, length, height)
+    s.nodes(nodes)
+    s.elements('CPE4R', conn, 'BAR')
+    s.nset('ALLN', list(nodes))
+    s.nset('DRIVEN', [node_2d(0, j, nx) for j in range(ny + 1)])
+    s.nset('FAR', [node_2d(nx, j, nx) for j in range(ny + 1)])
+    s.nset('SIDES', [node_2d(i, j, nx) for i in range(nx + 1) for j in (0, ny)])
+    for k, x in enumerate(stations):
+        i = round(x / h)
+        s.nset(f'STATION{k + 1}', [node_2d(i, j, nx) for j in range(ny + 1)])
+    s.elastic_material('BAR', thickness=1.0)
+    s.add('*BOUNDARY', 'SIDES, 2, 2', 'FAR, 1, 1')
+    s.add('*STEP, NAME=WAVE', '*DYNAMIC, EXPLICIT', f', {fmt(period)}')
+    s.add('*BOUNDARY, TYPE=VELOCITY', f'DRIVEN, 1, 1, {fmt(v0)}')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
+    s.add(f'*OUTPUT, HISTORY, TIME INTERVAL={fmt(0.25 * h / c)}', '*ENERGY OUTPUT')
+    s.add('*NODE OUTPUT, NSET=STATION1', 'V1', '*NODE OUTPUT, NSET=STATION2', 'V1')
+    s.add('*NODE OUTPUT, NSET=DRIVEN', 'RF1')
+    s.add('*END STEP')
+    return s
+
+
+def wave_bar_3d() -> Scene:
+    nx, nyz, length, width, v0 = 100, 2, 1.0, 0.02, 0.5
+    c = wave_speed()
+    h = length / nx
+    period = 0.8 * length / c
+    stations = (0.2, 0.6)
+    s = Scene('wave_bar_3d', 'verification: 1D elastic wave in a bar (C3D8R)',
+              {'kind': 'wave', 'ndim': 3, 'rho': RHO, 'E': E, 'nu': NU, 'v0': v0, 'length': length,
+               'stations': ' '.join(fmt(x) for x in stations), 'axis': 1},
+              ['Square bar along x, lateral rollers (u2 = 0 on the y faces, u3 = 0 on the z faces), far',
+               'end fixed; the end x = 0 is driven into the bar at v0: front at c_d = sqrt(M/rho),',
+               'sigma_11 = -rho c_d v0, sigma_22 = sigma_33 = nu/(1-nu) sigma_11.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes, conn = grid_3d(nx, nyz, nyz, length, width, width)
+    s.nodes(nodes)
+    s.elements('C3D8R', conn, 'BAR')
+    rng = range(nyz + 1)
+    s.nset('DRIVEN', [node_3d(0, j, k, nx, nyz) for j in rng for k in rng])
+    s.nset('FAR', [node_3d(nx, j, k, nx, nyz) for j in rng for k in rng])
+    s.nset('YFACES', [node_3d(i, j, k, nx, nyz) for i in range(nx + 1) for j in (0, nyz) for k in rng])
+    s.nset('ZFACES', [node_3d(i, j, k, nx, nyz) for i in range(nx + 1) for j in rng for k in (0, nyz)])
+    for n, x in enumerate(stations):
+        i = round(x / h)
+        s.nset(f'STATION{n + 1}', [node_3d(i, j, k, nx, nyz) for j in rng for k in rng])
+    s.elastic_material('BAR')
+    s.add('*BOUNDARY', 'YFACES, 2, 2', 'ZFACES, 3, 3', 'FAR, 1, 1')
+    s.add('*STEP, NAME=WAVE', '*DYNAMIC, EXPLICIT', f', {fmt(period)}')
+    s.add('*BOUNDARY, TYPE=VELOCITY', f'DRIVEN, 1, 1, {fmt(v0)}')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
+    s.add(f'*OUTPUT, HISTORY, TIME INTERVAL={fmt(0.25 * h / c)}', '*ENERGY OUTPUT')
+    s.add('*NODE OUTPUT, NSET=STATION1', 'V1', '*NODE OUTPUT, NSET=STATION2', 'V1')
+    s.add('*END STEP')
+    return s
+
+
+# ---------------------------------------------------------------------------------------------
+# 2. Gravity-loaded elastic column
+
+def column_2d(name='column_2d', nx=4, ny=20, ramp_periods=10.0, hold_periods=2.0, ramp=True,
+              restart=False) -> Scene:
+    width, height = 0.2, 1.0
+    c = wave_speed()
+    t1 = 4 * height / c                      # fundamental period of the column
+    t_ramp = ramp_periods * t1
+    period = t_ramp + hold_periods * t1
+    s = Scene(name, 'verification: gravity-loaded elastic column, plane strain (CPE4R)',
+              {'kind': 'column', 'ndim': 2, 'rho': RHO, 'E': E, 'nu': NU, 'g': G, 'height': height,
+               'settled': 'yes' if ramp else 'no'},
+              ['Plane-strain column, lateral rollers (u1 = 0 on x = 0 and x = W), bottom on rollers',
+               '(u2 = 0). Gravity ramped by a smooth step over ten fundamental periods 4H/c_d, then',
+               'held: settled state sigma_22 = -rho g (H - y), sigma_11 = sigma_33 = nu/(1-nu) sigma_22.'
+               if ramp else 'Gravity applied at once (a dynamic run, for rank and restart comparisons).',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes, conn = grid_2d(nx, ny, width, height)
+    s.nodes(nodes)
+    s.elements('CPE4R', conn, 'COLUMN')
+    s.nset('LEFT', [node_2d(0, j, nx) for j in range(ny + 1)])
+    s.nset('RIGHT', [node_2d(nx, j, nx) for j in range(ny + 1)])
+    s.nset('BOTTOM', [node_2d(i, 0, nx) for i in range(nx + 1)])
+    s.nset('TOP', [node_2d(i, ny, nx) for i in range(nx + 1)])
+    s.elastic_material('COLUMN', thickness=1.0)
+    if ramp:
+        s.add('*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP', f'0., 0., {fmt(t_ramp)}, 1.')
+    s.add('*BOUNDARY', 'LEFT, XSYMM', 'RIGHT, XSYMM', 'BOTTOM, YSYMM')
+    s.add('*STEP, NAME=GRAVITY', '*DYNAMIC, EXPLICIT', f', {fmt(period)}')
+    s.add('*DLOAD' + (', AMPLITUDE=RAMP' if ramp else ''), ', GRAV, 9.81, 0., -1.')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=10', '*NODE OUTPUT', 'U, V, RF', '*ELEMENT OUTPUT', 'S')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=200', '*ENERGY OUTPUT', '*NODE OUTPUT, NSET=TOP', 'U2')
+    if restart:
+        s.add('*RESTART, WRITE, NUMBER INTERVAL=5')
+    s.add('*END STEP')
+    return s
+
+
+def column_3d() -> Scene:
+    n_lat, nz, width, height = 2, 10, 0.2, 1.0
+    c = wave_speed()
+    t1 = 4 * height / c
+    t_ramp = 10 * t1
+    period = t_ramp + 2 * t1
+    s = Scene('column_3d', 'verification: gravity-loaded elastic column (C3D8R)',
+              {'kind': 'column', 'ndim': 3, 'rho': RHO, 'E': E, 'nu': NU, 'g': G, 'height': height,
+               'settled': 'yes'},
+              ['Square column along z, lateral rollers (u1 = 0 on the x faces, u2 = 0 on the y faces),',
+               'bottom on rollers (u3 = 0). Gravity -z ramped by a smooth step over ten periods 4H/c_d,',
+               'then held: sigma_33 = -rho g (H - z), sigma_11 = sigma_22 = nu/(1-nu) sigma_33.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes, conn = grid_3d(n_lat, n_lat, nz, width, width, height)
+    s.nodes(nodes)
+    s.elements('C3D8R', conn, 'COLUMN')
+    rng = range(n_lat + 1)
+    s.nset('XFACES', [node_3d(i, j, k, n_lat, n_lat) for i in (0, n_lat) for j in rng for k in range(nz + 1)])
+    s.nset('YFACES', [node_3d(i, j, k, n_lat, n_lat) for i in rng for j in (0, n_lat) for k in range(nz + 1)])
+    s.nset('BOTTOM', [node_3d(i, j, 0, n_lat, n_lat) for i in rng for j in rng])
+    s.nset('TOP', [node_3d(i, j, nz, n_lat, n_lat) for i in rng for j in rng])
+    s.elastic_material('COLUMN')
+    s.add('*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP', f'0., 0., {fmt(t_ramp)}, 1.')
+    s.add('*BOUNDARY', 'XFACES, XSYMM', 'YFACES, YSYMM', 'BOTTOM, ZSYMM')
+    s.add('*STEP, NAME=GRAVITY', '*DYNAMIC, EXPLICIT', f', {fmt(period)}')
+    s.add('*DLOAD, AMPLITUDE=RAMP', ', GRAV, 9.81, 0., 0., -1.')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=10', '*NODE OUTPUT', 'U, V, RF', '*ELEMENT OUTPUT', 'S')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=200', '*ENERGY OUTPUT', '*NODE OUTPUT, NSET=TOP', 'U3')
+    s.add('*END STEP')
+    return s
+
+
+# ---------------------------------------------------------------------------------------------
+# 3. Block on a frictional incline
+
+def incline_2d(name: str, alpha_deg: float, mu: float, n=2, period=0.4) -> Scene:
+    size = 0.1
+    a = math.radians(alpha_deg)
+    t = (math.cos(a), -math.sin(a))          # down the slope
+    nrm = (math.sin(a), math.cos(a))         # out of the slope, into the material
+    accel = max(0.0, G * (math.sin(a) - mu * math.cos(a)))
+    s = Scene(name, f'verification: block on a {alpha_deg:g} degree incline, mu = {mu:g} (CPE4R)',
+              {'kind': 'incline', 'ndim': 2, 'rho': RHO, 'E': E, 'nu': NU, 'g': G, 'alpha': alpha_deg,
+               'mu': mu, 'slope': f'{fmt(t[0])} {fmt(t[1])}', 'accel': fmt(accel)},
+              [f'Elastic block, {n} x {n} elements, resting on an analytic rigid line through the origin',
+               f'at {alpha_deg:g} degrees (TYPE=SEGMENTS, material on the left of travel), Coulomb',
+               f'friction mu = {mu:g}, gravity -y from t = 0. Slides with a = g (sin a - mu cos a)'
+               if accel > 0 else 'Sticks: tan(alpha) < mu.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes, conn = grid_2d(n, n, size, size, frame=(t, nrm))
+    s.nodes(nodes)
+    s.elements('CPE4R', conn, 'BLOCK')
+    s.nset('BLOCKN', list(nodes))
+    s.elset('BASE', [i + 1 for i in range(n)])
+    s.elastic_material('BLOCK', thickness=1.0)
+    s.add('*SURFACE, NAME=BOTTOM', 'BASE, S1')
+    s.add('*SURFACE, TYPE=SEGMENTS, NAME=SLOPE',
+          f'START, {fmt(-0.5 * t[0])}, {fmt(-0.5 * t[1])}', f'LINE, {fmt(2.0 * t[0])}, {fmt(2.0 * t[1])}')
+    s.add('*SURFACE INTERACTION, NAME=ROUGH', '*FRICTION', fmt(mu))
+    s.add('*CONTACT PAIR, INTERACTION=ROUGH', 'BOTTOM, SLOPE')
+    s.add('*STEP, NAME=SLIDE', '*DYNAMIC, EXPLICIT', f', {fmt(period)}')
+    s.add('*DLOAD', ', GRAV, 9.81, 0., -1.')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=200', '*ENERGY OUTPUT', '*NODE OUTPUT, NSET=BLOCKN', 'U, V')
+    s.add('*END STEP')
+    return s
+
+
+def incline_3d(name: str, alpha_deg: float, mu: float, n=2, period=0.4) -> Scene:
+    size = 0.1
+    a = math.radians(alpha_deg)
+    t = (math.cos(a), 0.0, -math.sin(a))
+    nrm = (math.sin(a), 0.0, math.cos(a))
+    accel = max(0.0, G * (math.sin(a) - mu * math.cos(a)))
+    s = Scene(name, f'verification: block on a {alpha_deg:g} degree incline, mu = {mu:g} (C3D8R)',
+              {'kind': 'incline', 'ndim': 3, 'rho': RHO, 'E': E, 'nu': NU, 'g': G, 'alpha': alpha_deg,
+               'mu': mu, 'slope': ' '.join(fmt(x) for x in t), 'accel': fmt(accel)},
+              [f'Elastic cube, {n}^3 elements, on the analytic rigid plane through the origin with',
+               f'normal (sin a, 0, cos a), a = {alpha_deg:g} degrees (TYPE=PLANE), Coulomb friction',
+               f'mu = {mu:g}, gravity -z from t = 0: a = g (sin a - mu cos a) down the fall line.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes, conn = grid_3d(n, n, n, size, size, size, frame=(t, (0.0, 1.0, 0.0), nrm))
+    s.nodes(nodes)
+    s.elements('C3D8R', conn, 'BLOCK')
+    s.nset('BLOCKN', list(nodes))
+    s.elset('BASE', [i + 1 for i in range(n * n)])
+    s.elastic_material('BLOCK')
+    s.add('*SURFACE, NAME=BOTTOM', 'BASE, S1')
+    s.add('*SURFACE, TYPE=PLANE, NAME=SLOPE', '0., 0., 0.', ', '.join(fmt(x) for x in nrm))
+    s.add('*SURFACE INTERACTION, NAME=ROUGH', '*FRICTION', fmt(mu))
+    s.add('*CONTACT PAIR, INTERACTION=ROUGH', 'BOTTOM, SLOPE')
+    s.add('*STEP, NAME=SLIDE', '*DYNAMIC, EXPLICIT', f', {fmt(period)}')
+    s.add('*DLOAD', ', GRAV, 9.81, 0., 0., -1.')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=200', '*ENERGY OUTPUT', '*NODE OUTPUT, NSET=BLOCKN', 'U, V')
+    s.add('*END STEP')
+    return s
+
+
+# ---------------------------------------------------------------------------------------------
+# 4. Patch tests
+
+PATCH_2D_NODES = {1: (0.0, 0.0), 2: (0.24, 0.0), 3: (0.24, 0.12), 4: (0.0, 0.12),
+                  5: (0.04, 0.02), 6: (0.18, 0.03), 7: (0.16, 0.08), 8: (0.08, 0.08)}
+PATCH_2D_CONN = {1: (1, 2, 6, 5), 2: (2, 3, 7, 6), 3: (3, 4, 8, 7), 4: (4, 1, 5, 8), 5: (5, 6, 7, 8)}
+
+# MacNeal & Harder (1985) 3D patch geometry: unit cube, seven hexahedra around an irregular inner
+# one. Their inner nodes (MH below) leave a corner Jacobian of the y = 0 side element slightly
+# negative (-0.013 at node 13), which our inversion check rightly rejects; the inner nodes here
+# are moved halfway towards the regular cube [0.25, 0.75]^3 (smallest corner Jacobian 0.025).
+_MH_INNER = {9: (0.249, 0.342, 0.192), 10: (0.826, 0.288, 0.288), 11: (0.850, 0.649, 0.263),
+             12: (0.273, 0.750, 0.230), 13: (0.320, 0.186, 0.643), 14: (0.677, 0.305, 0.683),
+             15: (0.788, 0.693, 0.644), 16: (0.165, 0.745, 0.702)}
+_REGULAR_INNER = {9: (0.25, 0.25, 0.25), 10: (0.75, 0.25, 0.25), 11: (0.75, 0.75, 0.25),
+                  12: (0.25, 0.75, 0.25), 13: (0.25, 0.25, 0.75), 14: (0.75, 0.25, 0.75),
+                  15: (0.75, 0.75, 0.75), 16: (0.25, 0.75, 0.75)}
+PATCH_3D_NODES = {1: (0.0, 0.0, 0.0), 2: (1.0, 0.0, 0.0), 3: (1.0, 1.0, 0.0), 4: (0.0, 1.0, 0.0),
+                  5: (0.0, 0.0, 1.0), 6: (1.0, 0.0, 1.0), 7: (1.0, 1.0, 1.0), 8: (0.0, 1.0, 1.0)}
+PATCH_3D_NODES.update({n: tuple(round(0.5 * (a + b), 4) for a, b in zip(_MH_INNER[n], _REGULAR_INNER[n]))
+                       for n in _MH_INNER})
+PATCH_3D_CONN = {1: (9, 10, 11, 12, 13, 14, 15, 16),      # inner
+                 2: (1, 2, 3, 4, 9, 10, 11, 12),          # bottom
+                 3: (13, 14, 15, 16, 5, 6, 7, 8),         # top
+                 4: (1, 2, 10, 9, 5, 6, 14, 13),          # y = 0 side
+                 5: (2, 3, 11, 10, 6, 7, 15, 14),         # x = 1 side
+                 6: (3, 4, 12, 11, 7, 8, 16, 15),         # y = 1 side
+                 7: (4, 1, 9, 12, 8, 5, 13, 16)}          # x = 0 side
+
+
+def quad_area(p):
+    return 0.5 * ((p[2][0] - p[0][0]) * (p[3][1] - p[1][1]) - (p[3][0] - p[1][0]) * (p[2][1] - p[0][1]))
+
+
+def hex_corner_jacobians(p):
+    """det of the three edges at each corner (positive for a valid Abaqus-ordered hexahedron)."""
+    nbr = {0: (1, 3, 4), 1: (2, 0, 5), 2: (3, 1, 6), 3: (0, 2, 7), 4: (7, 5, 0), 5: (4, 6, 1), 6: (5, 7, 2),
+           7: (6, 4, 3)}
+    dets = []
+    for i, (a, b, c) in nbr.items():
+        u = [p[a][d] - p[i][d] for d in range(3)]
+        v = [p[b][d] - p[i][d] for d in range(3)]
+        w = [p[c][d] - p[i][d] for d in range(3)]
+        dets.append(u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+                    + u[2] * (v[0] * w[1] - v[1] * w[0]))
+    return dets
+
+
+def fix_hex_orientation(conn, nodes):
+    out = {}
+    for e, c in conn.items():
+        dets = hex_corner_jacobians([nodes[n] for n in c])
+        if min(dets) < 0:
+            c = c[4:] + c[:4]            # swap the two faces: reverses the orientation
+            dets = hex_corner_jacobians([nodes[n] for n in c])
+        if min(dets) <= 0:
+            raise ValueError(f'patch element {e} is not a valid hexahedron: {dets}')
+        out[e] = c
+    return out
+
+
+def patch(ndim: int) -> Scene:
+    # A symmetric velocity gradient L: the motion x = (I + L t) X is homogeneous, F = I + L t is
+    # symmetric positive definite, so R = I and the corotational strain is log(I + L t).
+    if ndim == 2:
+        nodes, conn = PATCH_2D_NODES, PATCH_2D_CONN
+        for e, c in conn.items():
+            if quad_area([nodes[n] for n in c]) <= 0:
+                raise ValueError(f'patch element {e} is clockwise')
+        grad = [[0.10, 0.04], [0.04, -0.06]]
+        etype, name, boundary_nodes = 'CPE4R', 'patch_2d', [1, 2, 3, 4]
+    else:
+        nodes, conn = PATCH_3D_NODES, fix_hex_orientation(PATCH_3D_CONN, PATCH_3D_NODES)
+        grad = [[0.10, 0.04, -0.02], [0.04, -0.06, 0.03], [-0.02, 0.03, 0.05]]
+        etype, name, boundary_nodes = 'C3D8R', 'patch_3d', list(range(1, 9))
+    period = 0.02
+    flat = ' '.join(fmt(grad[i][j]) for i in range(ndim) for j in range(ndim))
+    s = Scene(name, f'verification: constant-strain patch test, distorted {etype} mesh',
+              {'kind': 'patch', 'ndim': ndim, 'rho': RHO, 'E': E, 'nu': NU, 'grad': flat, 'period': period,
+               'boundary': ' '.join(str(n) for n in boundary_nodes)},
+              ['Distorted patch (MacNeal-Harder geometry); every node starts with v = L X and the',
+               'boundary nodes keep it (velocity BCs): the exact motion is homogeneous, x = (I + L t) X,',
+               'with uniform stress sigma = lambda tr(E) I + 2 G E, E = log(I + L t) (L symmetric, so',
+               'R = I). Bulk viscosity off: its pressure depends on the element length, not uniform.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    s.nodes(nodes)
+    s.elements(etype, conn, 'PATCH')
+    s.elastic_material('PATCH', thickness=1.0 if ndim == 2 else None)
+    s.add('*INITIAL CONDITIONS, TYPE=VELOCITY')
+    vel = {}
+    for n in sorted(nodes):
+        x = nodes[n]
+        vel[n] = [sum(grad[i][j] * x[j] for j in range(ndim)) for i in range(ndim)]
+        for i in range(ndim):
+            s.add(f'{n}, {i + 1}, {fmt(vel[n][i])}')
+    s.add('*STEP, NAME=STRETCH', '*DYNAMIC, EXPLICIT', f', {fmt(period)}')
+    s.add('*BULK VISCOSITY', '0., 0.')
+    s.add('*BOUNDARY, TYPE=VELOCITY')
+    for n in boundary_nodes:
+        for i in range(ndim):
+            s.add(f'{n}, {i + 1}, {i + 1}, {fmt(vel[n][i])}')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=2', '*NODE OUTPUT', 'U, V, A', '*ELEMENT OUTPUT', 'S')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=50', '*ENERGY OUTPUT')
+    s.add('*END STEP')
+    return s
+
+
+# ---------------------------------------------------------------------------------------------
+# 8. Inverted element
+
+def inverted_2d() -> Scene:
+    s = Scene('inverted_2d', 'verification: an element crushed against a rigid floor',
+              {'kind': 'inverted', 'ndim': 2, 'element': 2},
+              ['Two elements thrown at 2000 m/s onto a rigid floor: the bottom nodes stop on the floor,',
+               'the top ones do not, so the elements invert within an increment or two. The run must',
+               'stop with the element, the time and the reason, a non-zero exit status and no NaN.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes, conn = grid_2d(2, 1, 0.2, 0.1)
+    s.nodes(nodes)
+    s.elements('CPE4R', conn, 'BLOCK')
+    s.nset('ALLN', list(nodes))
+    s.elastic_material('BLOCK', thickness=1.0)
+    s.add('*SURFACE, NAME=BOTTOM', 'BLOCK, S1')
+    s.add('*SURFACE, TYPE=SEGMENTS, NAME=FLOOR', 'START, -1., 0.', 'LINE, 1., 0.')
+    s.add('*SURFACE INTERACTION, NAME=SMOOTH')
+    s.add('*CONTACT PAIR, INTERACTION=SMOOTH', 'BOTTOM, FLOOR')
+    s.add('*INITIAL CONDITIONS, TYPE=VELOCITY', 'ALLN, 2, -2000.')
+    s.add('*STEP, NAME=CRASH', '*DYNAMIC, EXPLICIT', ', 0.01')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=10', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=100', '*ENERGY OUTPUT')
+    s.add('*END STEP')
+    return s
+
+
+# ---------------------------------------------------------------------------------------------
+# 6.-7. Rank agreement and restart: dynamic scenes with every kind of state
+
+def restart_2d() -> Scene:
+    """Mohr-Coulomb sand (angle table on a user field: VUSDFLD + state variables) on a rough
+    floor driven by a moving rigid body, gravity, a lid pushed by a velocity BC; checkpoints."""
+    nx, ny, size = 4, 4, 0.2
+    s = Scene('restart_2d', 'verification: restart and rank agreement, MC sand on a moving rough floor',
+              {'kind': 'dynamic', 'ndim': 2},
+              ['Mohr-Coulomb block (friction angle table against the VUSDFLD field) on a rough rigid',
+               'floor that is moved sideways, gravity, a lid pushed down: plastic flow, sliding and state',
+               'variables, to compare runs on 1-4 ranks and a run interrupted and restarted.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes, conn = grid_2d(nx, ny, size, size)
+    nodes[1000] = (0.1, -0.1)
+    s.nodes(nodes)
+    s.elements('CPE4R', conn, 'SAND')
+    s.nset('LID', [node_2d(i, ny, nx) for i in range(nx + 1)])
+    s.nset('ALLN', [n for n in nodes if n != 1000])
+    s.elset('BASE', [i + 1 for i in range(nx)])
+    s.add('*SOLID SECTION, ELSET=SAND, MATERIAL=SAND', '1.0')
+    s.add('*MATERIAL, NAME=SAND', '*DENSITY', fmt(RHO), '*ELASTIC', f'{fmt(E)}, {fmt(NU)}',
+          '*MOHR COULOMB, DEPENDENCIES=1', '30., 5., , -0.01', '35., 8., , 0.', '40., 10., , 0.01',
+          '*MOHR COULOMB HARDENING', '2000., 0.', '*DEPVAR', '8', '*USER DEFINED FIELD')
+    s.add('*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP', '0., 0., 0.02, 1.')
+    s.add('*SURFACE, NAME=BOTTOM', 'BASE, S1')
+    s.add('*SURFACE, TYPE=SEGMENTS, NAME=FLOOR', 'START, -1., 0.', 'LINE, 1., 0.')
+    s.add('*RIGID BODY, REF NODE=1000, ANALYTICAL SURFACE=FLOOR')
+    s.add('*SURFACE INTERACTION, NAME=ROUGH', '*FRICTION', '0.4')
+    s.add('*CONTACT PAIR, INTERACTION=ROUGH', 'BOTTOM, FLOOR')
+    s.add('*INITIAL CONDITIONS, TYPE=STRESS', 'SAND, -2000., -4000., -2000., 0.')
+    s.add('*STEP, NAME=PUSH', '*DYNAMIC, EXPLICIT', ', 0.04')
+    s.add('*BOUNDARY', '1000, 2, 2')
+    s.add('*BOUNDARY, TYPE=VELOCITY, AMPLITUDE=RAMP', '1000, 1, 1, 0.5', 'LID, 2, 2, -0.3')
+    s.add('*DLOAD, AMPLITUDE=RAMP', ', GRAV, 9.81, 0., -1.')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=8', '*NODE OUTPUT', 'U, V, A, RF', '*ELEMENT OUTPUT', 'S, SDV, FV')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=40', '*ENERGY OUTPUT', '*NODE OUTPUT, NSET=LID', 'RF2, U2')
+    s.add('*RESTART, WRITE, NUMBER INTERVAL=4')
+    s.add('*END STEP')
+    return s
+
+
+def mpi_column_2d() -> Scene:
+    return column_2d(name='mpi_column_2d', nx=6, ny=16, ramp=False, ramp_periods=0.0, hold_periods=1.0)
+
+
+def mpi_column_3d() -> Scene:
+    s = column_3d()
+    return s
+
+
+def all_scenes() -> list[Scene]:
+    return [wave_bar_2d(), wave_bar_3d(), column_2d(), column_3d(),
+            incline_2d('incline_slide_2d', 30.0, 0.3), incline_2d('incline_stick_2d', 20.0, 0.5),
+            incline_3d('incline_slide_3d', 30.0, 0.3), incline_3d('incline_stick_3d', 20.0, 0.5),
+            patch(2), patch(3), inverted_2d(), restart_2d(), mpi_column_2d(),
+            incline_2d('mpi_incline_2d', 30.0, 0.3, n=4, period=0.1)]
+
+
+def main() -> None:
+    repo = Path(__file__).resolve().parent.parent
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument('--out', type=Path, default=repo / 'inputs' / 'verification')
+    args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    for scene in all_scenes():
+        path = scene.write(args.out)
+        print(path)
+
+
+if __name__ == '__main__':
+    main()
