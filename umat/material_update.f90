@@ -2,6 +2,9 @@
 !>
 !> This is the hot path: one routine per model, each looping over the `nblock` points of a
 !> VUMAT call with the component index outside the point index (`(nblock, ncomp)` arrays).
+!> Mohr-Coulomb runs in chunks of block_points points through the block kernels
+!> (principal_*_block, mohr_coulomb_return_block), one vectorised loop per step, and gives
+!> the results of the point-by-point scalar kernels bit for bit.
 !> Per-point parameters (friction and dilation angles from tables, cohesion from the flow
 !> function or the hardening table) are evaluated with the start-of-increment state, i.e.
 !> lagged by one increment, which is consistent for an explicit code with small increments.

@@ -36,6 +36,9 @@
 !> inline into a block loop. The cut-off is entered only when the Mohr–Coulomb result violates
 !> σ1 ≤ σt: the Rankine return alone in closed form (about 25 ns), and only where Mohr–Coulomb is
 !> active as well an active-set solve over the candidate plane sets (numerics.md §1.7).
+!> mohr_coulomb_return_block is the same return on up to block_points points at once, in one
+!> branch-free loop that gfortran vectorises, with the same results bit for bit (the cut-off,
+!> where active, goes through the scalar routine in a second pass).
 module mohr_coulomb_return
   use, intrinsic :: iso_fortran_env, only: int64
   use material_kinds, only: dp

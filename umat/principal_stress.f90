@@ -3,7 +3,10 @@
 !>
 !> This module owns:
 !>   * principal_plane / rebuild_plane  — plane strain (components 11,22,33,12; 33 is principal);
-!>   * principal_3d    / rebuild_3d     — 3D (components 11,22,33,12,23,31, the VUMAT order).
+!>   * principal_3d    / rebuild_3d     — 3D (components 11,22,33,12,23,31, the VUMAT order);
+!>   * *_block versions of all four    — the same on up to block_points points at once, one
+!>     branch-free loop over the points that gfortran vectorises (see "Block versions" below),
+!>     with the same results bit for bit.
 !> Principal values come out sorted σ1 ≥ σ2 ≥ σ3 (tension positive, σ3 most compressive).
 !> The rebuild routines accept *any* diagonal values in the stored basis, so they also rotate
 !> principal plastic strains back (tensor shear components, like the stresses).
@@ -18,7 +21,10 @@
 !> over 2·10^6 random tensors incl. double, triple and nearly repeated roots and magnitudes
 !> 1e-150..1e150; unit tests ask for 1e-13), eigenvectors are orthonormal to ~1.5e-15.
 !> Cost (gfortran 12 -O3, not inlined, one AMD EPYC core): principal_plane ≈ 10 ns,
-!> principal_3d ≈ 95 ns; the 3D time is the latency of its sqrt/div chain.
+!> principal_3d ≈ 95 ns; the 3D time is the latency of its sqrt/div chain. The block versions
+!> work on two points per SSE2 instruction and overlap the chains of successive points:
+!> principal_3d_block costs about half of principal_3d per point, principal_plane_block a
+!> few ns (measured on a busy machine, so indicative only).
 module principal_stress
   use, intrinsic :: iso_fortran_env, only: int64
   use material_kinds, only: dp
@@ -320,16 +326,18 @@ contains
   !    and integer masks pick the bits. merge() would also be branch-free in the source, but
   !    the optimiser turns merges back into branches and moves the arithmetic that follows
   !    them into those branches; under the default -ftrapping-math a floating-point operation
-  !    under a branch stops the vectoriser. (merge() of values that are only stored is safe.)
+  !    under a branch stops the vectoriser. (rebuild_plane_block keeps merge() for its
+  !    selections by slot number: they pick loaded values, which is safe, and vectorises.)
   !  * every point evaluates every case (the special cases too), so the operands of sqrt and of
   !    the divisions are guarded (a floor, or a substitute value for the case that is not
   !    taken) and no lane, used or not, can trap in the debug build.
   ! Two-dimensional arrays have block_points rows, of which the first n ≤ block_points are used,
   ! so that a caller keeps fixed-size work arrays and passes a shorter last chunk without a copy.
   ! The only results that may differ from the scalar routines, in the last bits, are those of
-  ! tensors whose size is outside [1e-100, 1e100] (3D) or whose in-plane deviator is outside
-  ! [1e-150, 1e150]: the block routines scale them by fixed powers of two instead of exponent-
-  ! dependent ones.
+  ! tensors whose size is outside [1e-100, 1e100] (3D), whose in-plane deviator is outside
+  ! [1e-150, 1e150], or (3D) whose close pair of roots differs by less than 1e-150 of the
+  ! deviator without being equal: the block routines scale these by fixed powers of two instead
+  ! of exponent-dependent ones, which can change a result only where a square underflows.
   ! ---------------------------------------------------------------------------------------------
 
   !> principal_plane on n points: s(k, 1:4) = (11, 22, 33, 12) of point k; sig(k, :) sorted

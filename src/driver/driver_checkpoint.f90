@@ -46,7 +46,7 @@ contains
     call checkpoint_put(ck, 'rigid_v', rigid_array(solver, .false.))
     call checkpoint_put(ck, 'scalars', [solver%e_viscous, solver%e_artificial, solver%e_friction, &
          solver%e_external, solver%step_start, solver%dt_prev, solver%dt_stable, out%next_field, &
-         out%next_history, out%energy_reference])
+         out%next_history, out%energy_reference, out%energy_first, out%energy_peak])
     call checkpoint_put(ck, 'counters', [solver%step_increment, solver%dt_element])
     do ib = 1, solver%n_blocks
        write (tag, '(a,i0,a)') 'b', ib, '_'
@@ -73,7 +73,7 @@ contains
     integer, intent(out) :: step, frames, rows
     type(checkpoint_t) :: ck
     type(checkpoint_header_t) :: header
-    real(dp) :: scalars(10)
+    real(dp) :: scalars(12)
     real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
     integer :: counters(2), ib, i
     character(len=16) :: tag
@@ -129,6 +129,8 @@ contains
     solver%restart_next_field = scalars(8)
     solver%restart_next_history = scalars(9)
     solver%restart_energy_reference = scalars(10)
+    solver%restart_energy_first = scalars(11)
+    solver%restart_energy_peak = scalars(12)
   end subroutine load_checkpoint
 
   function rigid_array(solver, displacement) result(values)

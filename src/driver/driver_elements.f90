@@ -123,7 +123,7 @@ contains
     integer, intent(in) :: hourglass_kind
     real(dp), intent(in) :: hourglass_coefficient
     integer :: e, nc, ns
-    character(len=160) :: text
+    character(len=64) :: text
     logical :: plane
 
     nc = solver%ncomp
@@ -142,10 +142,12 @@ contains
          default_min_volume_ratio, w%reason(1:nb))
     if (any(w%reason(1:nb) /= 0)) then
        e = findloc(w%reason(1:nb) /= 0, .true., dim=1)
-       write (text, '(a,i0,a,es12.5,a)') 'element ', blk%elem_number(e), ' at total time ', &
-            solver%total_time + dt, ': ' // inversion_reason_text(w%reason(e)) // &
-            ' (increment too large, mesh too coarse for the deformation, or material too soft)'
-       call raise_error(trim(m%input_file), 0, trim(text))
+       ! The reason text is long: numbers go through a small buffer, the message is built by
+       ! concatenation (an internal write of the whole message overflowed its buffer).
+       write (text, '(a,i0,a,es12.5)') 'element ', blk%elem_number(e), ' at total time ', &
+            solver%total_time + dt
+       call raise_error(trim(m%input_file), 0, trim(text) // ': ' // inversion_reason_text(w%reason(e)) // &
+            ' (increment too large, mesh too coarse for the deformation, or material too soft)')
     end if
 
     call corotational_increment(nb, nd, ne, blk%bmat_ref, w%xe_mid(1:nb, :, :), w%xe_new(1:nb, :, :), &

@@ -28,6 +28,9 @@ module driver_output
      character(len=32), allocatable :: columns(:)   !< history column names
      real(dp) :: next_field = 0, next_history = 0   !< step times of the next frame / row
      real(dp) :: energy_reference = 0               !< ETOTAL at the start (subtracted)
+     !> Energy-balance check: the energy scale after the first increment and the largest energy
+     !> max(ALLKE, ALLIE, |ALLWK|) seen so far (write_history).
+     real(dp) :: energy_first = -1, energy_peak = 0
      logical :: balance_warned = .false.
      integer(int64) :: wall_start = 0, wall_last_progress = 0, clock_rate = 1
      real(dp) :: sim_start = 0
@@ -296,8 +299,11 @@ contains
     end select
   end subroutine write_element_variable
 
-  !> Global energies [ALLKE, ALLIE, ALLVD, ALLFD, ALLWK, ALLAE] at t_{n+1}; the kinetic energy
-  !> uses v_{n+1} = v_{n+1/2} + dt/2 a_{n+1}; ALLIE includes ALLAE as in Abaqus.
+  !> Global energies [ALLKE, ALLIE, ALLVD, ALLFD, ALLWK, ALLAE] at t_{n+1}; ALLIE includes ALLAE
+  !> as in Abaqus. The kinetic energy is the central-difference one, ½ m v_{n+1/2}·v_{n+3/2} with
+  !> the unconstrained v_{n+3/2} = v_{n+1/2} + Δt a_{n+1}: the leapfrog invariant, so the balance
+  !> with the trapezoidal work terms is exact for linear problems (v_{n+1} = v_{n+1/2} + Δt/2 a_{n+1}
+  !> squared, used before, carries an O(Δt²) term ⅛ Δt² |f|²/m that nothing balances).
   subroutine energy_values(solver, e)
     type(solver_t), intent(in) :: solver
     real(dp), intent(out) :: e(6)
@@ -306,7 +312,7 @@ contains
     e = 0
     do i = 1, solver%n_nodes
        if (.not. solver%part%node_owned(i)) cycle
-       e(1) = e(1) + 0.5_dp * solver%mass(i) * sum((solver%v(:, i) + 0.5_dp * solver%dt * solver%a(:, i))**2)
+       e(1) = e(1) + 0.5_dp * solver%mass(i) * sum(solver%v(:, i) * (solver%v(:, i) + solver%dt * solver%a(:, i)))
     end do
     do ib = 1, solver%n_blocks
        e(2) = e(2) + sum(solver%blocks(ib)%mass * solver%blocks(ib)%e_int)
@@ -319,8 +325,15 @@ contains
     call global_sum(solver%part, e)
   end subroutine energy_values
 
-  !> One history row; also the energy-balance check (warning once when |ETOTAL| exceeds 1 %
-  !> of the largest energy).
+  !> One history row; also the energy-balance check: a warning, once, when |ETOTAL| exceeds 1 %
+  !> of the largest energy max(ALLKE, ALLIE, |ALLWK|) seen so far — but only once that peak is
+  !> significant, at least 100 times the energy scale after the first increment (energy_first).
+  !> Why: the balance is exact up to O(Δt²) except for one start-up term of the first
+  !> half-increment, −⅛ Δt² Σ|f_0|²/m (a sudden load), which never grows; it is at most a quarter
+  !> of the kinetic energy after the first increment (½ Δt² |f_0|²/m), so beyond 100 times that
+  !> energy it is below 0.25 % of the peak and cannot raise the 1 % warning by itself. Before
+  !> that point the comparison is between round-off-sized numbers (energies of 1e-14 J at the
+  !> first rows) and said nothing; the previous check fired there.
   subroutine write_history(m, solver, out, istep)
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
@@ -353,10 +366,11 @@ contains
     end do
     call set_values(m, solver, istep, out%columns, row)
     call history_row(out%history, row)
-    if (.not. out%balance_warned .and. solver%part%rank == 0) then
-       if (abs(etotal) > 0.01_dp * max(e(1), e(2), e(5), tiny(1.0_dp)) .and. max(e(1), e(2), e(5)) > 0) then
-          write (error_unit, '(a,es10.3,a,es10.3,a)') 'bulkflow: warning: energy balance ETOTAL = ', etotal, &
-               ' exceeds 1 % of the largest energy (', max(e(1), e(2), e(5)), ')'
+    out%energy_peak = max(out%energy_peak, e(1), e(2), abs(e(5)))
+    if (.not. out%balance_warned .and. solver%part%rank == 0 .and. out%energy_first >= 0) then
+       if (out%energy_peak > 100 * out%energy_first .and. abs(etotal) > 0.01_dp * out%energy_peak) then
+          write (error_unit, '(a,es10.3,a,es10.3,a,es12.5)') 'bulkflow: warning: energy balance ETOTAL = ', &
+               etotal, ' exceeds 1 % of the largest energy (', out%energy_peak, ') at t = ', solver%total_time
           out%balance_warned = .true.
        end if
     end if

@@ -88,6 +88,8 @@ contains
        out%next_field = solver%restart_next_field
        out%next_history = solver%restart_next_history
        out%energy_reference = solver%restart_energy_reference
+       out%energy_first = solver%restart_energy_first
+       out%energy_peak = solver%restart_energy_peak
     else
        call open_run_output(m, solver, out, opts%output_base)
     end if
@@ -111,6 +113,12 @@ contains
              solver%dt_stable = initial_stable_dt(m, solver, m%steps(1)%bulk_linear)
              call energy_values(solver, energies)
              out%energy_reference = energies(1) + energies(2) + energies(3) + energies(4) - energies(5)
+          else
+             ! The step's loads and constraints from its first increment on: gravity at step time
+             ! 0 of this step, and accelerations/reactions with this step's prescribed dofs (a dof
+             ! released now must accelerate in the first increment, not keep a = 0).
+             if (effects%active(effect_gravity)) call gravity_forces(m, loads, solver, 0.0_dp, solver%f_ext)
+             call update_accelerations(solver)
           end if
           call write_outputs(m, solver, out, effects, istep)
        end if
@@ -118,6 +126,11 @@ contains
 
        do while (solver%step_time < period * (1 - 1.0e-12_dp))
           call one_increment(m, solver, effects, ew, loads, istep, hg_kind, hg_coefficient, dt_min)
+          if (out%energy_first < 0) then
+             ! Energy scale of the first increment, for the energy-balance check (write_history).
+             call energy_values(solver, energies)
+             out%energy_first = max(energies(1), energies(2), abs(energies(5)))
+          end if
           call write_outputs(m, solver, out, effects, istep)
           call progress_line(m, solver, out, istep, .false.)
           if (effects%active(effect_checkpoint)) then
@@ -173,7 +186,9 @@ contains
 
       ! Velocities at mid-increment (the first increment of the run starts from v_0 with dt/2).
       dt_avg = merge(0.5_dp * dt, 0.5_dp * (solver%dt_prev + dt), solver%increment == 0)
+      solver%v_old = solver%v
       solver%v = solver%v + dt_avg * solver%a
+      solver%v_free = solver%v
 
       if (effects%active(effect_boundary)) then
          call effects%start(effect_boundary)
@@ -181,6 +196,7 @@ contains
          call apply_rigid_body_velocities(m, loads, solver, t_mid, t_new, dt)
          call effects%stop(effect_boundary)
       end if
+      work = 0
       if (effects%active(effect_rigid_walls)) then
          call effects%start(effect_rigid_walls)
          call apply_contact(m, loads, solver, dt, work)
@@ -189,6 +205,7 @@ contains
          call apply_prescribed_velocities(m, loads, solver, t_mid, t_new, dt)
          call effects%stop(effect_rigid_walls)
       end if
+      call constraint_work(solver, dt_avg, work)
 
       solver%du = dt * solver%v
       call element_phase(m, solver, effects, ew, solver%x0 + solver%u, solver%du, dt, s%bulk_linear, &
@@ -207,14 +224,12 @@ contains
          call gravity_forces(m, loads, solver, t_new, solver%f_ext)
          call effects%stop(effect_gravity)
       end if
-      solver%reaction_old = solver%reaction
       call update_accelerations(solver)
 
-      ! External work of this rank's owned nodes: gravity (trapezoidal), supports and walls.
+      ! Work of gravity on this rank's owned nodes (trapezoidal rule over the increment).
       do i = 1, solver%n_nodes
          if (.not. solver%part%node_owned(i)) cycle
-         solver%e_external = solver%e_external + sum((0.5_dp * (solver%f_ext_old(:, i) + solver%f_ext(:, i)) &
-              + 0.5_dp * (solver%reaction_old(:, i) + solver%reaction(:, i)) + solver%f_contact(:, i)) &
+         solver%e_external = solver%e_external + sum(0.5_dp * (solver%f_ext_old(:, i) + solver%f_ext(:, i)) &
               * solver%du(:, i))
       end do
 
@@ -228,6 +243,40 @@ contains
       solver%dt_element = dt_elem
     end associate
   end subroutine one_increment
+
+  !> External work of the kinematic constraints at t_n — prescribed velocities/displacements
+  !> (supports) and rigid walls — added to ALLWK on this rank's owned nodes.
+  !>
+  !> The constraints act as impulses: with the force balance of the central-difference step,
+  !> m (v_{n+1/2} − v_{n-1/2}) = Δt_avg (f_ext − f_int)_n + I_n, the impulse of a node is
+  !> I_n = m (v_{n+1/2} − v_free) + Δt_avg R_n, where v_free = v_{n-1/2} + Δt_avg a_n and R_n the
+  !> static reaction f_int − f_ext of a prescribed dof (a_n = 0 there; R_n = 0 on free dofs). Its
+  !> work is I_n · ½(v_{n-1/2} + v_{n+1/2}): with the kinetic energy ½ m v_{n+1/2}·(v_{n+1/2} + Δt a_{n+1})
+  !> (energy_values) and the trapezoidal internal and gravity work, the balance is then exact for
+  !> a linear system at constant Δt, whatever the constraints do. (Before: ½(R_n + R_{n+1})·Δu with
+  !> the static reactions only — the inertia of a driven node was missing, a sudden velocity cost
+  !> ½ m v² unaccounted — and the contact forces times Δu, which counted friction twice, once in
+  !> ALLFD and once as negative work.)
+  !>
+  !> For a wall the impulse work is the work of the wall (Σ F·v_wall Δt) minus the frictional
+  !> dissipation minus the kinetic energy a perfectly plastic landing removes. ALLFD reports the
+  !> friction (the contact kernel's friction_work) separately, so it is added back here: ALLWK
+  !> holds the wall's work and the landing losses (Abaqus books the latter as ALLPW, which we do
+  !> not have). A fixed wall with steady sliding contributes nothing, as in Abaqus.
+  subroutine constraint_work(solver, dt_avg, friction_work)
+    type(solver_t), intent(inout) :: solver
+    real(dp), intent(in) :: dt_avg, friction_work
+    integer :: i
+    real(dp) :: work
+
+    work = 0
+    do i = 1, solver%n_nodes
+       if (.not. solver%part%node_owned(i) .or. solver%mass(i) <= 0) cycle
+       work = work + sum((solver%mass(i) * (solver%v(:, i) - solver%v_free(:, i)) + dt_avg * solver%reaction(:, i)) &
+            * 0.5_dp * (solver%v_old(:, i) + solver%v(:, i)))
+    end do
+    solver%e_external = solver%e_external + work + friction_work
+  end subroutine constraint_work
 
   !> a = (f_ext − f_int)/m on free dofs; reactions f_int − f_ext on prescribed ones.
   subroutine update_accelerations(solver)

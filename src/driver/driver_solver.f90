@@ -52,7 +52,10 @@ module driver_solver
      real(dp), allocatable :: mass(:)
      real(dp), allocatable :: f_int(:, :), f_ext(:, :), f_contact(:, :), reaction(:, :)
      logical, allocatable :: fixed(:, :)              !< (ndim, n_nodes) dof prescribed this step
-     real(dp), allocatable :: du(:, :), f_ext_old(:, :), reaction_old(:, :)  !< increment work arrays
+     real(dp), allocatable :: du(:, :), f_ext_old(:, :)  !< increment work arrays
+     !> v_{n-1/2} and the unconstrained v_{n+1/2} = v_{n-1/2} + Δt_avg a_n of the increment: the
+     !> constraint impulses (supports, walls) are m (v − v_free) and their work uses both.
+     real(dp), allocatable :: v_old(:, :), v_free(:, :)
      real(dp), allocatable :: fe(:, :, :)             !< (n_local_elems, ndim, nen) element forces
      integer :: n_blocks = 0
      type(element_block_t), allocatable :: blocks(:)
@@ -71,6 +74,7 @@ module driver_solver
      integer :: dt_element = 0                        !< user number of the controlling element
      ! Output schedule carried through a restart (driver_checkpoint -> driver_run).
      real(dp) :: restart_next_field = 0, restart_next_history = 0, restart_energy_reference = 0
+     real(dp) :: restart_energy_first = -1, restart_energy_peak = 0
   end type solver_t
 
   public :: build_blocks
