@@ -32,6 +32,17 @@ G = 9.81
 # 2 x 2 blocks below blow up from round-off (reported to the lead); 0.8 is stable.
 FREE_BLOCK_SCALE = 0.8
 
+# The blocks on the incline carry a moment (friction at the base, weight at the centre): with
+# one-point elements part of it goes into the hourglass modes of the base row. With our default
+# viscous hourglass control nothing resists a steady hourglass deformation, so a block that
+# should stick creeps at a constant rate (2 x 2 block, 20 deg, mu 0.5: 0.5 mm/s, ALLAE 90 % of
+# ALLIE) and a sliding one dissipates as much in hourglass as it stores. The stiffness form
+# (Abaqus's default is a stiffness form too) holds the mode: ALLAE 3-5 % of ALLIE. Gravity is
+# ramped in (smooth step over GRAVITY_RAMP) so the sudden load does not set the block ringing.
+# Finer meshes are not better here: a sliding elastic body on a rigid plane with Coulomb friction
+# is dynamically unstable (frictional flutter); from 3 x 3 elements up it chatters.
+GRAVITY_RAMP = 0.05
+
 
 def fmt(x: float) -> str:
     """A real for a data line: full precision, always with a dot or exponent."""
@@ -77,8 +88,13 @@ class Scene:
         for i in range(0, len(members), 16):
             self.add(', '.join(str(m) for m in members[i:i + 16]))
 
-    def elastic_material(self, elset: str, thickness: float | None = None, name: str = 'SOLID') -> None:
-        self.add(f'*SOLID SECTION, ELSET={elset}, MATERIAL={name}')
+    def elastic_material(self, elset: str, thickness: float | None = None, name: str = 'SOLID',
+                         hourglass: str | None = None) -> None:
+        controls = ''
+        if hourglass:
+            self.add('*SECTION CONTROLS, NAME=HOURGLASS, HOURGLASS=' + hourglass)
+            controls = ', CONTROLS=HOURGLASS'
+        self.add(f'*SOLID SECTION, ELSET={elset}, MATERIAL={name}{controls}')
         self.add(fmt(thickness) if thickness is not None else ',')
         self.add(f'*MATERIAL, NAME={name}', '*DENSITY', fmt(RHO), '*ELASTIC', f'{fmt(E)}, {fmt(NU)}')
 
@@ -147,14 +163,14 @@ def wave_speed() -> float:
 # 1. Elastic wave in a bar
 
 def wave_bar_2d() -> Scene:
-    nx, ny, length, height, v0 = 200, 2, 1.0, 0.01, 0.5
+    nx, ny, length, height, v0 = 200, 2, 1.0, 0.01, 0.2
     c = wave_speed()
     h = length / nx
     period = 0.8 * length / c
     stations = (0.2, 0.6)
     s = Scene('wave_bar_2d', 'verification: 1D elastic wave in a plane-strain bar (CPE4R)',
               {'kind': 'wave', 'ndim': 2, 'rho': RHO, 'E': E, 'nu': NU, 'v0': v0, 'length': length,
-               'stations': ' '.join(fmt(x) for x in stations), 'axis': 1},
+               'stations': ' '.join(fmt(x) for x in stations), 'axis': 1, 'area': fmt(height * 1.0)},
               ['Plane-strain strip, lateral rollers (u2 = 0 on top and bottom), far end fixed; the',
                'end x = 0 is driven into the bar at v0 from t = 0: a compression front runs at',
                'c_d = sqrt(M/rho) with sigma_11 = -rho c_d v0 and particle velocity v0 behind it.',
@@ -175,21 +191,21 @@ def wave_bar_2d() -> Scene:
     s.add('*BOUNDARY, TYPE=VELOCITY', f'DRIVEN, 1, 1, {fmt(v0)}')
     s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
     s.add(f'*OUTPUT, HISTORY, TIME INTERVAL={fmt(0.25 * h / c)}', '*ENERGY OUTPUT')
-    s.add('*NODE OUTPUT, NSET=STATION1', 'V1', '*NODE OUTPUT, NSET=STATION2', 'V1')
+    s.add('*NODE OUTPUT, NSET=STATION1', 'V1, A1', '*NODE OUTPUT, NSET=STATION2', 'V1')
     s.add('*NODE OUTPUT, NSET=DRIVEN', 'RF1')
     s.add('*END STEP')
     return s
 
 
 def wave_bar_3d() -> Scene:
-    nx, nyz, length, width, v0 = 100, 2, 1.0, 0.02, 0.5
+    nx, nyz, length, width, v0 = 100, 2, 1.0, 0.02, 0.2
     c = wave_speed()
     h = length / nx
     period = 0.8 * length / c
     stations = (0.2, 0.6)
     s = Scene('wave_bar_3d', 'verification: 1D elastic wave in a bar (C3D8R)',
               {'kind': 'wave', 'ndim': 3, 'rho': RHO, 'E': E, 'nu': NU, 'v0': v0, 'length': length,
-               'stations': ' '.join(fmt(x) for x in stations), 'axis': 1},
+               'stations': ' '.join(fmt(x) for x in stations), 'axis': 1, 'area': fmt(width * width)},
               ['Square bar along x, lateral rollers (u2 = 0 on the y faces, u3 = 0 on the z faces), far',
                'end fixed; the end x = 0 is driven into the bar at v0: front at c_d = sqrt(M/rho),',
                'sigma_11 = -rho c_d v0, sigma_22 = sigma_33 = nu/(1-nu) sigma_11.',
@@ -211,7 +227,8 @@ def wave_bar_3d() -> Scene:
     s.add('*BOUNDARY, TYPE=VELOCITY', f'DRIVEN, 1, 1, {fmt(v0)}')
     s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
     s.add(f'*OUTPUT, HISTORY, TIME INTERVAL={fmt(0.25 * h / c)}', '*ENERGY OUTPUT')
-    s.add('*NODE OUTPUT, NSET=STATION1', 'V1', '*NODE OUTPUT, NSET=STATION2', 'V1')
+    s.add('*NODE OUTPUT, NSET=STATION1', 'V1, A1', '*NODE OUTPUT, NSET=STATION2', 'V1')
+    s.add('*NODE OUTPUT, NSET=DRIVEN', 'RF1')
     s.add('*END STEP')
     return s
 
@@ -298,10 +315,12 @@ def incline_2d(name: str, alpha_deg: float, mu: float, n=2, period=0.4) -> Scene
     accel = max(0.0, G * (math.sin(a) - mu * math.cos(a)))
     s = Scene(name, f'verification: block on a {alpha_deg:g} degree incline, mu = {mu:g} (CPE4R)',
               {'kind': 'incline', 'ndim': 2, 'rho': RHO, 'E': E, 'nu': NU, 'g': G, 'alpha': alpha_deg,
-               'mu': mu, 'slope': f'{fmt(t[0])} {fmt(t[1])}', 'accel': fmt(accel)},
+               'mu': mu, 'slope': f'{fmt(t[0])} {fmt(t[1])}', 'accel': fmt(accel), 'ramp': GRAVITY_RAMP,
+               'mass': fmt(RHO * size * size)},
               [f'Elastic block, {n} x {n} elements, resting on an analytic rigid line through the origin',
                f'at {alpha_deg:g} degrees (TYPE=SEGMENTS, material on the left of travel), Coulomb',
-               f'friction mu = {mu:g}, gravity -y from t = 0. Slides with a = g (sin a - mu cos a)'
+               f'friction mu = {mu:g}, stiffness hourglass control, gravity -y ramped in over {GRAVITY_RAMP:g} s.',
+               'Slides with a = g (sin a - mu cos a)'
                if accel > 0 else 'Sticks: tan(alpha) < mu.',
                'Generated by scripts/make_verification_scenes.py.'])
     nodes, conn = grid_2d(n, n, size, size, frame=(t, nrm))
@@ -309,14 +328,15 @@ def incline_2d(name: str, alpha_deg: float, mu: float, n=2, period=0.4) -> Scene
     s.elements('CPE4R', conn, 'BLOCK')
     s.nset('BLOCKN', list(nodes))
     s.elset('BASE', [i + 1 for i in range(n)])
-    s.elastic_material('BLOCK', thickness=1.0)
+    s.elastic_material('BLOCK', thickness=1.0, hourglass='STIFFNESS')
+    s.add('*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP', f'0., 0., {fmt(GRAVITY_RAMP)}, 1.')
     s.add('*SURFACE, NAME=BOTTOM', 'BASE, S1')
     s.add('*SURFACE, TYPE=SEGMENTS, NAME=SLOPE',
           f'START, {fmt(-0.5 * t[0])}, {fmt(-0.5 * t[1])}', f'LINE, {fmt(2.0 * t[0])}, {fmt(2.0 * t[1])}')
     s.add('*SURFACE INTERACTION, NAME=ROUGH', '*FRICTION', fmt(mu))
     s.add('*CONTACT PAIR, INTERACTION=ROUGH', 'BOTTOM, SLOPE')
     s.add('*STEP, NAME=SLIDE', f'*DYNAMIC, EXPLICIT, SCALE FACTOR={FREE_BLOCK_SCALE}', f', {fmt(period)}')
-    s.add('*DLOAD', ', GRAV, 9.81, 0., -1.')
+    s.add('*DLOAD, AMPLITUDE=RAMP', ', GRAV, 9.81, 0., -1.')
     s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
     s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=200', '*ENERGY OUTPUT', '*NODE OUTPUT, NSET=BLOCKN', 'U, V')
     s.add('*END STEP')
@@ -331,23 +351,26 @@ def incline_3d(name: str, alpha_deg: float, mu: float, n=2, period=0.4) -> Scene
     accel = max(0.0, G * (math.sin(a) - mu * math.cos(a)))
     s = Scene(name, f'verification: block on a {alpha_deg:g} degree incline, mu = {mu:g} (C3D8R)',
               {'kind': 'incline', 'ndim': 3, 'rho': RHO, 'E': E, 'nu': NU, 'g': G, 'alpha': alpha_deg,
-               'mu': mu, 'slope': ' '.join(fmt(x) for x in t), 'accel': fmt(accel)},
+               'mu': mu, 'slope': ' '.join(fmt(x) for x in t), 'accel': fmt(accel), 'ramp': GRAVITY_RAMP,
+               'mass': fmt(RHO * size ** 3)},
               [f'Elastic cube, {n}^3 elements, on the analytic rigid plane through the origin with',
                f'normal (sin a, 0, cos a), a = {alpha_deg:g} degrees (TYPE=PLANE), Coulomb friction',
-               f'mu = {mu:g}, gravity -z from t = 0: a = g (sin a - mu cos a) down the fall line.',
+               f'mu = {mu:g}, stiffness hourglass control, gravity -z ramped in over {GRAVITY_RAMP:g} s:',
+               'a = g (sin a - mu cos a) down the fall line.' if accel > 0 else 'sticks: tan(alpha) < mu.',
                'Generated by scripts/make_verification_scenes.py.'])
     nodes, conn = grid_3d(n, n, n, size, size, size, frame=(t, (0.0, 1.0, 0.0), nrm))
     s.nodes(nodes)
     s.elements('C3D8R', conn, 'BLOCK')
     s.nset('BLOCKN', list(nodes))
     s.elset('BASE', [i + 1 for i in range(n * n)])
-    s.elastic_material('BLOCK')
+    s.elastic_material('BLOCK', hourglass='STIFFNESS')
+    s.add('*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP', f'0., 0., {fmt(GRAVITY_RAMP)}, 1.')
     s.add('*SURFACE, NAME=BOTTOM', 'BASE, S1')
     s.add('*SURFACE, TYPE=PLANE, NAME=SLOPE', '0., 0., 0.', ', '.join(fmt(x) for x in nrm))
     s.add('*SURFACE INTERACTION, NAME=ROUGH', '*FRICTION', fmt(mu))
     s.add('*CONTACT PAIR, INTERACTION=ROUGH', 'BOTTOM, SLOPE')
     s.add('*STEP, NAME=SLIDE', f'*DYNAMIC, EXPLICIT, SCALE FACTOR={FREE_BLOCK_SCALE}', f', {fmt(period)}')
-    s.add('*DLOAD', ', GRAV, 9.81, 0., 0., -1.')
+    s.add('*DLOAD, AMPLITUDE=RAMP', ', GRAV, 9.81, 0., 0., -1.')
     s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
     s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=200', '*ENERGY OUTPUT', '*NODE OUTPUT, NSET=BLOCKN', 'U, V')
     s.add('*END STEP')
@@ -423,13 +446,15 @@ def patch(ndim: int) -> Scene:
         for e, c in conn.items():
             if quad_area([nodes[n] for n in c]) <= 0:
                 raise ValueError(f'patch element {e} is clockwise')
-        grad = [[0.10, 0.04], [0.04, -0.06]]
+        grad = [[0.010, 0.004], [0.004, -0.006]]
         etype, name, boundary_nodes = 'CPE4R', 'patch_2d', [1, 2, 3, 4]
     else:
         nodes, conn = PATCH_3D_NODES, fix_hex_orientation(PATCH_3D_CONN, PATCH_3D_NODES)
-        grad = [[0.10, 0.04, -0.02], [0.04, -0.06, 0.03], [-0.02, 0.03, 0.05]]
+        grad = [[0.010, 0.004, -0.002], [0.004, -0.006, 0.003], [-0.002, 0.003, 0.005]]
         etype, name, boundary_nodes = 'C3D8R', 'patch_3d', list(range(1, 9))
-    period = 0.02
+    # Strains of ~2e-3 over ~70 (3D) to ~800 (2D) increments: the midpoint rule of the strain
+    # increments differs from log(I + L t) by ~(L dt)^2/24 relative, ~1e-11 here.
+    period = 0.2
     flat = ' '.join(fmt(grad[i][j]) for i in range(ndim) for j in range(ndim))
     s = Scene(name, f'verification: constant-strain patch test, distorted {etype} mesh',
               {'kind': 'patch', 'ndim': ndim, 'rho': RHO, 'E': E, 'nu': NU, 'grad': flat, 'period': period,
@@ -455,7 +480,7 @@ def patch(ndim: int) -> Scene:
     for n in boundary_nodes:
         for i in range(ndim):
             s.add(f'{n}, {i + 1}, {i + 1}, {fmt(vel[n][i])}')
-    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=2', '*NODE OUTPUT', 'U, V, A', '*ELEMENT OUTPUT', 'S')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=2', '*NODE OUTPUT', 'U, V, A', '*ELEMENT OUTPUT', 'S, LE')
     s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=50', '*ENERGY OUTPUT')
     s.add('*END STEP')
     return s
@@ -489,6 +514,102 @@ def inverted_2d() -> Scene:
 
 
 # ---------------------------------------------------------------------------------------------
+# Rigid rotation of a stretched element (corotational stress update and output frames)
+
+def rotation(ndim: int) -> Scene:
+    """One element, every node prescribed: step 1 stretches it along x by STRETCH (linear ramp),
+    step 2 rotates it rigidly by 90 degrees about z (per-node tabular amplitudes, 201 points).
+    The stretch then lies along y: LE = log(1 + STRETCH) e_y (x) e_y, sigma = lambda tr LE I +
+    2 G LE, in global components."""
+    # The last increment of step 1 is shortened to end the step, and the supports change speed
+    # there: the scene also checks the energy balance across a change of increment.
+    stretch, t_stretch, t_rotate, points = 0.01, 0.01, 0.2, 201
+    size = 0.1
+    if ndim == 2:
+        nodes, conn = grid_2d(1, 1, size, size)
+        etype = 'CPE4R'
+    else:
+        nodes, conn = grid_3d(1, 1, 1, size, size, size)
+        etype = 'C3D8R'
+    name = f'rotation_{ndim}d'
+    s = Scene(name, f'verification: stretch, then a rigid 90 degree rotation ({etype})',
+              {'kind': 'rotation', 'ndim': ndim, 'rho': RHO, 'E': E, 'nu': NU, 'stretch': stretch},
+              [f'One {etype} element, all nodes prescribed. Step 1: stretch 1 + {stretch:g} along x;',
+               'step 2: rigid rotation by 90 degrees about z (tabular amplitude per node and dof).',
+               'Afterwards LE = log(1 + stretch) along y and sigma = lambda tr LE I + 2 G LE, both in',
+               'global components: checks the corotational stress update and the output frames.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    s.nodes(nodes)
+    s.elements(etype, conn, 'ONE')
+    s.elastic_material('ONE', thickness=1.0 if ndim == 2 else None)
+    s.add('*AMPLITUDE, NAME=LINEAR', f'0., 0., {fmt(t_stretch)}, 1.')
+    for n in sorted(nodes):
+        x, y = nodes[n][0], nodes[n][1]
+        for d in (1, 2):
+            values = []
+            for k in range(points):
+                th = 0.5 * math.pi * k / (points - 1)
+                xs = (1 + stretch) * x
+                pos = (math.cos(th) * xs - math.sin(th) * y, math.sin(th) * xs + math.cos(th) * y)
+                values.append((t_rotate * k / (points - 1), pos[d - 1] - (x, y)[d - 1]))
+            s.add(f'*AMPLITUDE, NAME=R{n}_{d}')
+            for i in range(0, points, 4):
+                s.add(', '.join(f'{fmt(t)}, {fmt(v)}' for t, v in values[i:i + 4]))
+    s.add('*STEP, NAME=STRETCH', '*DYNAMIC, EXPLICIT', f', {fmt(t_stretch)}')
+    s.add('*BOUNDARY, AMPLITUDE=LINEAR')
+    for n in sorted(nodes):
+        s.add(f'{n}, 1, 1, {fmt(stretch * nodes[n][0])}', f'{n}, 2, 2, 0.')
+        if ndim == 3:
+            s.add(f'{n}, 3, 3, 0.')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=2', '*NODE OUTPUT', 'U', '*ELEMENT OUTPUT', 'S, LE')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=20', '*ENERGY OUTPUT')
+    s.add('*END STEP')
+    s.add('*STEP, NAME=ROTATE', '*DYNAMIC, EXPLICIT', f', {fmt(t_rotate)}')
+    for n in sorted(nodes):
+        for d in (1, 2):
+            s.add(f'*BOUNDARY, AMPLITUDE=R{n}_{d}', f'{n}, {d}, {d}, 1.')
+    s.add('*END STEP')
+    return s
+
+
+# ---------------------------------------------------------------------------------------------
+# Hourglass control per section
+
+def hourglass_sections_2d() -> Scene:
+    """Two separate elements with different section controls: the first section (viscous, the
+    default) on an element at rest, the second (stiffness) on an element whose nodes start in the
+    hourglass mode h = (1, -1, 1, -1). Stiffness control stores the mode's energy and gives it
+    back (ALLAE rises and falls); had the first section's form been used for both (the driver
+    did that), ALLAE would only grow."""
+    v0 = 0.1
+    s = Scene('hourglass_sections_2d', 'verification: hourglass control taken from each element\'s section',
+              {'kind': 'sections', 'ndim': 2, 'v0': v0},
+              ['Element 1 (viscous hourglass, the first section) at rest; element 2 (stiffness',
+               'hourglass, the second section) with its nodes moving in the hourglass mode',
+               'h = (1, -1, 1, -1) along x: the mode oscillates, ALLAE rises and falls.',
+               'Generated by scripts/make_verification_scenes.py.'])
+    nodes = {1: (0.0, 0.0), 2: (0.1, 0.0), 3: (0.1, 0.1), 4: (0.0, 0.1),
+             5: (1.0, 0.0), 6: (1.1, 0.0), 7: (1.1, 0.1), 8: (1.0, 0.1)}
+    s.nodes(nodes)
+    s.elements('CPE4R', {1: (1, 2, 3, 4), 2: (5, 6, 7, 8)}, 'ALLE')
+    s.elset('VISCOUS', [1])
+    s.elset('STIFF', [2])
+    s.add('*SOLID SECTION, ELSET=VISCOUS, MATERIAL=SOLID', '1.0')
+    s.add('*SECTION CONTROLS, NAME=HGSTIFF, HOURGLASS=STIFFNESS')
+    s.add('*SOLID SECTION, ELSET=STIFF, MATERIAL=SOLID, CONTROLS=HGSTIFF', '1.0')
+    s.add('*MATERIAL, NAME=SOLID', '*DENSITY', fmt(RHO), '*ELASTIC', f'{fmt(E)}, {fmt(NU)}')
+    s.add('*INITIAL CONDITIONS, TYPE=VELOCITY')
+    for n, sign in zip((5, 6, 7, 8), (1, -1, 1, -1)):
+        s.add(f'{n}, 1, {fmt(sign * v0)}')
+    # Single free elements: critical increment 0.837 h/c_d (see FREE_BLOCK_SCALE), hence 0.7.
+    s.add('*STEP, NAME=RING', '*DYNAMIC, EXPLICIT, SCALE FACTOR=0.7', ', 0.02')
+    s.add('*OUTPUT, FIELD, NUMBER INTERVAL=4', '*NODE OUTPUT', 'U, V', '*ELEMENT OUTPUT', 'S')
+    s.add('*OUTPUT, HISTORY, NUMBER INTERVAL=400', '*ENERGY OUTPUT')
+    s.add('*END STEP')
+    return s
+
+
+# ---------------------------------------------------------------------------------------------
 # 6.-7. Rank agreement and restart: dynamic scenes with every kind of state
 
 def restart_2d() -> Scene:
@@ -497,7 +618,8 @@ def restart_2d() -> Scene:
     nx, ny, size = 4, 4, 0.2
     s = Scene('restart_2d', 'verification: restart and rank agreement, MC sand on a moving rough floor',
               {'kind': 'dynamic', 'ndim': 2},
-              ['Mohr-Coulomb block (friction angle table against the VUSDFLD field) with initial stress on',
+              ['Mohr-Coulomb block (friction angle table against the VUSDFLD field) under an elastic top',
+               'row (a second material, without state variables), with initial stress on',
                'a rough rigid floor. Step 1: gravity ramped in; step 2: the floor (a rigid body) is moved',
                'sideways and the lid pushed down: plastic flow, sliding and state variables, to compare',
                'runs on 1-4 ranks and runs interrupted and restarted (also across the step boundary).',
@@ -509,7 +631,13 @@ def restart_2d() -> Scene:
     s.nset('LID', [node_2d(i, ny, nx) for i in range(nx + 1)])
     s.nset('ALLN', [n for n in nodes if n != 1000])
     s.elset('BASE', [i + 1 for i in range(nx)])
-    s.add('*SOLID SECTION, ELSET=SAND, MATERIAL=SAND', '1.0')
+    # The top row is a second, elastic material without state variables: blocks of two
+    # materials with different *DEPVAR counts (8 and none).
+    s.elset('CAP', [i + 1 + nx * (ny - 1) for i in range(nx)])
+    s.elset('BELOW', [i + 1 for i in range(nx * (ny - 1))])
+    s.add('*SOLID SECTION, ELSET=BELOW, MATERIAL=SAND', '1.0')
+    s.add('*SOLID SECTION, ELSET=CAP, MATERIAL=CAP', '1.0')
+    s.add('*MATERIAL, NAME=CAP', '*DENSITY', fmt(RHO), '*ELASTIC', f'{fmt(2 * E)}, {fmt(NU)}')
     s.add('*MATERIAL, NAME=SAND', '*DENSITY', fmt(RHO), '*ELASTIC', f'{fmt(E)}, {fmt(NU)}',
           '*MOHR COULOMB, DEPENDENCIES=1', '30., 5., , -0.01', '35., 8., , 0.', '40., 10., , 0.01',
           '*MOHR COULOMB HARDENING', '2000., 0.', '*DEPVAR', '8', '*USER DEFINED FIELD')
@@ -546,8 +674,8 @@ def mpi_column_3d() -> Scene:
 def all_scenes() -> list[Scene]:
     return [wave_bar_2d(), wave_bar_3d(), column_2d(), column_3d(),
             incline_2d('incline_slide_2d', 30.0, 0.3), incline_2d('incline_stick_2d', 20.0, 0.5),
-            incline_3d('incline_slide_3d', 30.0, 0.3), incline_3d('incline_stick_3d', 20.0, 0.5),
-            patch(2), patch(3), inverted_2d(), restart_2d(), mpi_column_2d(),
+            incline_3d('incline_slide_3d', 30.0, 0.3), incline_3d('incline_stick_3d', 20.0, 0.5, n=3),
+            patch(2), patch(3), rotation(2), rotation(3), hourglass_sections_2d(), inverted_2d(), restart_2d(), mpi_column_2d(),
             incline_2d('mpi_incline_2d', 30.0, 0.3, n=4, period=0.1)]
 
 

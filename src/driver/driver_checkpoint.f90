@@ -46,7 +46,7 @@ contains
     call checkpoint_put(ck, 'rigid_v', rigid_array(solver, .false.))
     call checkpoint_put(ck, 'scalars', [solver%e_viscous, solver%e_artificial, solver%e_friction, &
          solver%e_external, solver%step_start, solver%dt_prev, solver%dt_stable, out%next_field, &
-         out%next_history, out%energy_reference, out%energy_first, out%energy_peak])
+         out%next_history, out%energy_reference, out%energy_peak])
     call checkpoint_put(ck, 'counters', [solver%step_increment, solver%dt_element])
     do ib = 1, solver%n_blocks
        write (tag, '(a,i0,a)') 'b', ib, '_'
@@ -60,6 +60,8 @@ contains
          call checkpoint_put(ck, trim(tag) // 'e_int', b%e_int)
          call checkpoint_put(ck, trim(tag) // 'e_inel', b%e_inel)
          call checkpoint_put(ck, trim(tag) // 'log_strain', b%log_strain)
+         call checkpoint_put(ck, trim(tag) // 'sigma_bv', b%sigma_bv)
+         call checkpoint_put(ck, trim(tag) // 'force_hg', b%force_hg)
        end associate
     end do
     call checkpoint_end_write(ck)
@@ -73,7 +75,7 @@ contains
     integer, intent(out) :: step, frames, rows
     type(checkpoint_t) :: ck
     type(checkpoint_header_t) :: header
-    real(dp) :: scalars(12)
+    real(dp) :: scalars(11)
     real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
     integer :: counters(2), ib, i
     character(len=16) :: tag
@@ -123,14 +125,15 @@ contains
          call checkpoint_get(ck, trim(tag) // 'e_int', b%e_int)
          call checkpoint_get(ck, trim(tag) // 'e_inel', b%e_inel)
          call checkpoint_get(ck, trim(tag) // 'log_strain', b%log_strain)
+         call checkpoint_get(ck, trim(tag) // 'sigma_bv', b%sigma_bv)
+         call checkpoint_get(ck, trim(tag) // 'force_hg', b%force_hg)
        end associate
     end do
     call checkpoint_end_read(ck)
     solver%restart_next_field = scalars(8)
     solver%restart_next_history = scalars(9)
     solver%restart_energy_reference = scalars(10)
-    solver%restart_energy_first = scalars(11)
-    solver%restart_energy_peak = scalars(12)
+    solver%restart_energy_peak = scalars(11)
   end subroutine load_checkpoint
 
   function rigid_array(solver, displacement) result(values)

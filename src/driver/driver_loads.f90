@@ -272,22 +272,27 @@ contains
   !> walls (a concave corner: hopper wall and outlet plate). Returns the frictional work of this
   !> rank's owned slaves; f_contact gets the contact forces of owned slaves and wall_force the
   !> force on each wall (minus the force on the material).
-  subroutine apply_contact(m, loads, solver, dt, friction_work)
+  !> The kernel's force is m Δv/Δt; the impulse of the step belongs to t_n, whose velocity change
+  !> spans Δt_avg = ½(Δt_{n-1/2} + Δt_{n+1/2}), so the force is m Δv/Δt_avg: scaled here by
+  !> Δt/Δt_avg (before, the wall force of a block at rest was 2.6 times its weight on the
+  !> shortened last increment of a step, and twice it on the first increment of the run).
+  subroutine apply_contact(m, loads, solver, dt, dt_avg, friction_work)
     type(model_t), intent(in) :: m
     type(step_loads_t), intent(in) :: loads
     type(solver_t), intent(inout) :: solver
-    real(dp), intent(in) :: dt
+    real(dp), intent(in) :: dt, dt_avg
     real(dp), intent(out) :: friction_work
     integer :: j, pass, npass, i, nd
     real(dp), allocatable :: x(:, :), force(:, :)
     logical, allocatable :: touching(:)
-    real(dp) :: work
+    real(dp) :: work, scale
 
     nd = solver%ndim
     friction_work = 0
     solver%f_contact = 0
     solver%wall_force = 0
     if (size(loads%contact) == 0) return
+    scale = dt / dt_avg
     allocate(x(nd, solver%n_nodes))
     x = solver%x0 + solver%u
     npass = merge(2, 1, size(loads%contact) > 1)
@@ -300,8 +305,8 @@ contains
                  body%u(1:nd), body%v(1:nd), c%mu, force, work, touching)
             friction_work = friction_work + work
             do i = 1, size(c%owned)
-               solver%f_contact(:, c%owned(i)) = solver%f_contact(:, c%owned(i)) + force(:, i)
-               solver%wall_force(:, c%wall) = solver%wall_force(:, c%wall) - force(:, i)
+               solver%f_contact(:, c%owned(i)) = solver%f_contact(:, c%owned(i)) + scale * force(:, i)
+               solver%wall_force(:, c%wall) = solver%wall_force(:, c%wall) - scale * force(:, i)
             end do
             deallocate(force, touching)
             allocate(force(nd, size(c%others)), touching(size(c%others)))

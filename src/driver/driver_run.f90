@@ -11,12 +11,11 @@ module driver_run
   use model_mesh, only: element_cpe4r
   use parallel_partition, only: partition_t, partition_model
   use parallel_assembly, only: assemble_element_vectors, global_min, global_sum
-  use driver_solver, only: solver_t, block_size
+  use driver_solver, only: solver_t
   use driver_effects, only: effects_t, effect_gravity, effect_rigid_walls, effect_boundary, &
        effect_assembly, effect_output, effect_checkpoint, effect_user_field
   use driver_setup, only: setup_solver, initial_internal_forces
-  use driver_elements, only: element_work_t, element_work_init, element_phase
-  use driver_vumat_call, only: vumat_work_init
+  use driver_elements, only: element_workspace_t, element_workspace_init, element_phase
   use driver_loads, only: step_loads_t, prepare_step, apply_prescribed_velocities, &
        apply_rigid_body_velocities, gravity_forces, apply_contact
   use driver_output, only: run_output_t, open_run_output, close_run_output, step_output_start, &
@@ -26,8 +25,6 @@ module driver_run
   use fem_cpe4r, only: cpe4r_char_length
   use fem_c3d8r, only: c3d8r_char_length
   use fem_stable_dt, only: element_stable_dt
-  use fem_hourglass, only: hourglass_viscous, default_hourglass_viscous_coefficient, &
-       default_hourglass_stiffness_coefficient
   use output_timer, only: timer_report
   implicit none
   private
@@ -50,34 +47,24 @@ contains
     type(partition_t) :: part
     type(solver_t) :: solver
     type(effects_t) :: effects
-    type(element_work_t) :: ew
+    type(element_workspace_t) :: ew
     type(step_loads_t) :: loads
     type(run_output_t) :: out
-    integer :: istep, first_step, nmax, max_state, max_field, i, hg_kind, frames, rows
-    real(dp) :: hg_coefficient, dt_min, energies(6)
+    integer :: istep, first_step, max_state, max_field, i, frames, rows
+    real(dp) :: dt_min, energies(6)
     logical :: resumed, stop_now
     real(dp) :: period
 
     call partition_model(m, comm, part)
     call effects%decide(m)
     call setup_solver(m, part, solver, effects%active(effect_user_field))
-    nmax = min(block_size, max(1, part%n_local_elems))
-    call element_work_init(ew, nmax, solver%ndim, solver%nen, solver%ncomp, solver%nshr)
     max_state = 1
     max_field = 1
     do i = 1, m%n_materials
        max_state = max(max_state, m%materials(i)%nstatev)
        max_field = max(max_field, m%materials(i)%nfieldv)
     end do
-    call vumat_work_init(ew%vumat, nmax, solver%ncomp, solver%nshr, max_state, max_field)
-    hg_kind = hourglass_viscous
-    hg_coefficient = 0
-    if (m%n_sections > 0) then
-       hg_kind = m%sections(1)%hourglass
-       hg_coefficient = m%sections(1)%hourglass_coefficient
-    end if
-    if (hg_coefficient <= 0) hg_coefficient = merge(default_hourglass_viscous_coefficient, &
-         default_hourglass_stiffness_coefficient, hg_kind == hourglass_viscous)
+    call element_workspace_init(ew, solver%ndim, solver%nen, solver%ncomp, solver%nshr, max_state, max_field)
 
     first_step = 1
     resumed = .false.
@@ -88,12 +75,12 @@ contains
        out%next_field = solver%restart_next_field
        out%next_history = solver%restart_next_history
        out%energy_reference = solver%restart_energy_reference
-       out%energy_first = solver%restart_energy_first
        out%energy_peak = solver%restart_energy_peak
     else
        call open_run_output(m, solver, out, opts%output_base)
     end if
     out%progress = opts%progress
+    out%energy_floor = 1.0e-12_dp * strain_energy_scale(solver)
     if (part%rank == 0) call print_header(m, part, solver, effects, opts)
 
     stop_now = .false.
@@ -125,12 +112,7 @@ contains
        resumed = .false.
 
        do while (solver%step_time < period * (1 - 1.0e-12_dp))
-          call one_increment(m, solver, effects, ew, loads, istep, hg_kind, hg_coefficient, dt_min)
-          if (out%energy_first < 0) then
-             ! Energy scale of the first increment, for the energy-balance check (write_history).
-             call energy_values(solver, energies)
-             out%energy_first = max(energies(1), energies(2), abs(energies(5)))
-          end if
+          call one_increment(m, solver, effects, ew, loads, istep, dt_min)
           call write_outputs(m, solver, out, effects, istep)
           call progress_line(m, solver, out, istep, .false.)
           if (effects%active(effect_checkpoint)) then
@@ -139,6 +121,10 @@ contains
                 call save_checkpoint(opts%output_base, solver, out)
                 call effects%stop(effect_checkpoint)
              end if
+          else if (solver%increment == opts%stop_after) then
+             ! --stop-after always leaves a checkpoint to continue from, *RESTART or not (before,
+             ! a scene without *RESTART stopped, said "continue with --restart" and had none).
+             call save_checkpoint(opts%output_base, solver, out)
           end if
           if (solver%increment == opts%stop_after) then
              stop_now = .true.
@@ -160,14 +146,13 @@ contains
   end subroutine run_scene
 
   !> One central-difference increment, t_n → t_{n+1}.
-  subroutine one_increment(m, solver, effects, ew, loads, istep, hg_kind, hg_coefficient, dt_min)
+  subroutine one_increment(m, solver, effects, ew, loads, istep, dt_min)
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
     type(effects_t), intent(inout) :: effects
-    type(element_work_t), intent(inout) :: ew
+    type(element_workspace_t), intent(inout) :: ew
     type(step_loads_t), intent(in) :: loads
-    integer, intent(in) :: istep, hg_kind
-    real(dp), intent(in) :: hg_coefficient
+    integer, intent(in) :: istep
     real(dp), intent(out) :: dt_min
     real(dp) :: dt, dt_avg, t_mid, t_new, work
     integer :: i, dt_elem
@@ -199,7 +184,7 @@ contains
       work = 0
       if (effects%active(effect_rigid_walls)) then
          call effects%start(effect_rigid_walls)
-         call apply_contact(m, loads, solver, dt, work)
+         call apply_contact(m, loads, solver, dt, dt_avg, work)
          solver%e_friction = solver%e_friction + work
          ! A prescribed dof wins over contact, as in Abaqus.
          call apply_prescribed_velocities(m, loads, solver, t_mid, t_new, dt)
@@ -209,7 +194,7 @@ contains
 
       solver%du = dt * solver%v
       call element_phase(m, solver, effects, ew, solver%x0 + solver%u, solver%du, dt, s%bulk_linear, &
-           s%bulk_quadratic, hg_kind, hg_coefficient, dt_min, dt_elem)
+           s%bulk_quadratic, dt_min, dt_elem)
       solver%u = solver%u + solver%du
       do i = 1, size(solver%rigid)
          solver%rigid(i)%u = solver%rigid(i)%u + dt * solver%rigid(i)%v
@@ -248,15 +233,21 @@ contains
   !> (supports) and rigid walls — added to ALLWK on this rank's owned nodes.
   !>
   !> The constraints act as impulses: with the force balance of the central-difference step,
-  !> m (v_{n+1/2} − v_{n-1/2}) = Δt_avg (f_ext − f_int)_n + I_n, the impulse of a node is
-  !> I_n = m (v_{n+1/2} − v_free) + Δt_avg R_n, where v_free = v_{n-1/2} + Δt_avg a_n and R_n the
-  !> static reaction f_int − f_ext of a prescribed dof (a_n = 0 there; R_n = 0 on free dofs). Its
-  !> work is I_n · ½(v_{n-1/2} + v_{n+1/2}): with the kinetic energy ½ m v_{n+1/2}·(v_{n+1/2} + Δt a_{n+1})
-  !> (energy_values) and the trapezoidal internal and gravity work, the balance is then exact for
-  !> a linear system at constant Δt, whatever the constraints do. (Before: ½(R_n + R_{n+1})·Δu with
-  !> the static reactions only — the inertia of a driven node was missing, a sudden velocity cost
-  !> ½ m v² unaccounted — and the contact forces times Δu, which counted friction twice, once in
-  !> ALLFD and once as negative work.)
+  !> m (v_{n+1/2} − v_{n-1/2}) = h_n m a_n + I_n (h_n = Δt_avg, a_n the unconstrained acceleration
+  !> (f_ext − f_int)/m, also on prescribed dofs, where the driver keeps a = 0 and the static
+  !> reaction R = f_int − f_ext), the impulse of a node is I_n = m (v_{n+1/2} − v_free) + h_n R_n
+  !> with v_free = v_{n-1/2} + h_n a. Its work is
+  !>     I_n·½(v_{n-1/2} + v_{n+1/2}) + ¼ (Δt_{n-1/2} − Δt_{n+1/2}) (h_n m |a_n|² + a_n·I_n),
+  !> which makes the balance exact for a linear system — with the kinetic energy
+  !> ½ m v_{n+1/2}·(v_{n+1/2} + Δt a_{n+1}) and the pending support work ½ Δt v·R of energy_values,
+  !> and the trapezoidal internal and gravity work — whatever the constraints do and however Δt
+  !> varies. The second term matters where Δt changes: at a step end (the last increment is
+  !> shortened) a support that changes speed there left ¼ ΔΔt R·Δv in ETOTAL for good (1.4 %
+  !> in rotation_2d). On the first increment Δt_{-1/2} = 0 and h_0 = Δt/2: the same formula is then
+  !> the start-up term of a suddenly applied load. (Before: ½(R_n + R_{n+1})·Δu with the static
+  !> reactions only — the inertia of a driven node was missing, a sudden velocity cost ½ m v²
+  !> unaccounted — and the contact forces times Δu, which counted friction twice, once in ALLFD
+  !> and once as negative work.)
   !>
   !> For a wall the impulse work is the work of the wall (Σ F·v_wall Δt) minus the frictional
   !> dissipation minus the kinetic energy a perfectly plastic landing removes. ALLFD reports the
@@ -267,16 +258,33 @@ contains
     type(solver_t), intent(inout) :: solver
     real(dp), intent(in) :: dt_avg, friction_work
     integer :: i
-    real(dp) :: work
+    real(dp) :: work, ddt, impulse(solver%ndim), a(solver%ndim)
 
     work = 0
+    ddt = 0.25_dp * (solver%dt_prev - solver%dt)
     do i = 1, solver%n_nodes
        if (.not. solver%part%node_owned(i) .or. solver%mass(i) <= 0) cycle
-       work = work + sum((solver%mass(i) * (solver%v(:, i) - solver%v_free(:, i)) + dt_avg * solver%reaction(:, i)) &
-            * 0.5_dp * (solver%v_old(:, i) + solver%v(:, i)))
+       a = solver%a(:, i) - solver%reaction(:, i) / solver%mass(i)
+       impulse = solver%mass(i) * (solver%v(:, i) - solver%v_free(:, i)) + dt_avg * solver%reaction(:, i)
+       work = work + 0.5_dp * sum(impulse * (solver%v_old(:, i) + solver%v(:, i))) &
+            + ddt * (dt_avg * solver%mass(i) * sum(a**2) + sum(a * impulse))
     end do
     solver%e_external = solver%e_external + work + friction_work
   end subroutine constraint_work
+
+  !> ½ Σ_e M_e V_e (M the P-wave modulus): the strain energy of the whole model at unit strain,
+  !> equal to ½ Σ m c_d², the kinetic energy at the wave speed. Scale of "significant" energies.
+  real(dp) function strain_energy_scale(solver)
+    type(solver_t), intent(in) :: solver
+    integer :: ib
+
+    strain_energy_scale = 0
+    do ib = 1, solver%n_blocks
+       strain_energy_scale = strain_energy_scale + 0.5_dp * solver%blocks(ib)%wave_modulus &
+            * sum(solver%blocks(ib)%volume_ref)
+    end do
+    call global_sum(solver%part, strain_energy_scale)
+  end function strain_energy_scale
 
   !> a = (f_ext − f_int)/m on free dofs; reactions f_int − f_ext on prescribed ones.
   subroutine update_accelerations(solver)

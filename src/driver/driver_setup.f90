@@ -26,7 +26,7 @@ contains
     type(solver_t), intent(inout) :: solver
     logical, intent(in) :: user_field_active
     integer :: nd, nn, i, j, k, ib, nb, e, g, le
-    real(dp), allocatable :: moduli(:), mass_e(:, :, :), mass2(:, :)
+    real(dp), allocatable :: moduli(:), mass_e(:, :, :), mass2(:, :), mass_b(:, :)
     logical, allocatable :: known(:)
 
     solver%part = part
@@ -71,8 +71,11 @@ contains
             user_field_active)
        nb = solver%blocks(ib)%count
        associate (blk => solver%blocks(ib))
-         call lumped_mass(nb, solver%nen, blk%mass / blk%volume_ref, blk%volume_ref, &
-              mass_e(blk%first:blk%first + nb - 1, 1, :))
+         ! Through a block-sized array: a section of mass_e would be copied in and out.
+         allocate(mass_b(nb, solver%nen))
+         call lumped_mass(nb, solver%nen, blk%mass / blk%volume_ref, blk%volume_ref, mass_b)
+         mass_e(blk%first:blk%first + nb - 1, 1, :) = mass_b
+         deallocate(mass_b)
        end associate
     end do
     allocate(mass2(1, nn))
@@ -137,8 +140,12 @@ contains
       allocate(blk%mass(nb), blk%rotation(nb, nd, nd), blk%hourglass(nb, nd, solver%nmode))
       allocate(blk%stress(nb, solver%ncomp), blk%stress_global(nb, solver%ncomp))
       allocate(blk%state(nb, blk%nstatev), blk%field(nb, blk%nfieldv), blk%e_int(nb), blk%e_inel(nb))
-      ! LE is kept only where a VUSDFLD will ask for it.
-      if (user_field_active .and. mat%user_field) then
+      allocate(blk%sigma_bv(nb), blk%force_hg(nb, nd, ne))
+      blk%sigma_bv = 0
+      blk%force_hg = 0
+      ! LE is kept where a VUSDFLD will ask for it, and everywhere when a step writes it (before,
+      ! only the former: a requested LE field of any other material was silently all zeros).
+      if ((user_field_active .and. mat%user_field) .or. log_strain_requested(m)) then
          allocate(blk%log_strain(nb, solver%ncomp))
       else
          allocate(blk%log_strain(0, solver%ncomp))
@@ -180,21 +187,38 @@ contains
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
     integer :: ib, nb
+    real(dp), allocatable :: fe(:, :, :)
 
     do ib = 1, solver%n_blocks
        associate (blk => solver%blocks(ib))
          nb = blk%count
+         allocate(fe(nb, solver%ndim, solver%nen))
          if (m%mesh%element_type == element_cpe4r) then
-            call cpe4r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, &
-                 solver%fe(blk%first:blk%first + nb - 1, :, :))
+            call cpe4r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, fe)
          else
-            call c3d8r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, &
-                 solver%fe(blk%first:blk%first + nb - 1, :, :))
+            call c3d8r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, fe)
          end if
+         solver%fe(blk%first:blk%first + nb - 1, :, :) = fe
+         deallocate(fe)
        end associate
     end do
     call assemble_element_vectors(solver%part, solver%ndim, solver%fe, solver%f_int)
   end subroutine initial_internal_forces
+
+  !> Does any step write the LE field?
+  pure logical function log_strain_requested(m)
+    type(model_t), intent(in) :: m
+    integer :: i, j
+
+    log_strain_requested = .false.
+    do i = 1, m%n_steps
+       if (.not. allocated(m%steps(i)%field_outputs)) cycle
+       do j = 1, size(m%steps(i)%field_outputs)
+          if (.not. allocated(m%steps(i)%field_outputs(j)%element_variables)) cycle
+          if (any(m%steps(i)%field_outputs(j)%element_variables == 'LE')) log_strain_requested = .true.
+       end do
+    end do
+  end function log_strain_requested
 
   !> Block and position of local element le.
   pure subroutine locate(solver, le, ib, e)

@@ -33,6 +33,8 @@ module driver_solver
      real(dp), allocatable :: field(:, :)             !< (count, nfieldv) field variables at t_n
      real(dp), allocatable :: e_int(:), e_inel(:)     !< specific energies (per unit mass)
      real(dp), allocatable :: log_strain(:, :)        !< accumulated corotational strain (LE)
+     real(dp), allocatable :: sigma_bv(:)             !< bulk-viscosity pressure of the last increment
+     real(dp), allocatable :: force_hg(:, :, :)       !< (count, ndim, nen) hourglass forces at t_n
      real(dp) :: wave_modulus = 0                     !< λ + 2G from the packaging call
   end type element_block_t
 
@@ -74,7 +76,7 @@ module driver_solver
      integer :: dt_element = 0                        !< user number of the controlling element
      ! Output schedule carried through a restart (driver_checkpoint -> driver_run).
      real(dp) :: restart_next_field = 0, restart_next_history = 0, restart_energy_reference = 0
-     real(dp) :: restart_energy_first = -1, restart_energy_peak = 0
+     real(dp) :: restart_energy_peak = 0
   end type solver_t
 
   public :: build_blocks

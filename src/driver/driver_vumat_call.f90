@@ -69,11 +69,18 @@ contains
     real(dp), intent(inout) :: stress(nb, ncomp), state(:, :), field(:, :)
     real(dp), intent(inout) :: e_int(nb), e_inel(nb)
     type(vumat_work_t), intent(inout) :: w
-    integer :: nstatev, nfieldv, nprops
+    integer :: nstatev, nfieldv, nprops, ns, nf
 
     nstatev = mat%nstatev
     nfieldv = mat%nfieldv
     nprops = size(mat%props)
+    ! The block's state and field arrays have this material's columns (at least one); the work
+    ! arrays have the largest count of all materials. Every copy and every argument uses the
+    ! block's count: whole-column assignments between the two failed (debug) or overran the
+    ! block's arrays (release) as soon as two materials had different *DEPVAR counts. The
+    ! sections (1:nb, 1:ns) are contiguous (the work arrays have exactly nb rows).
+    ns = size(state, 2)
+    nf = size(field, 2)
     w%jblock(1:4) = [nb, 1, 1, 1]
     w%jblock(5:4 + nb) = elem_number
     if (mat%user_field) then
@@ -81,20 +88,19 @@ contains
        w%field_new(1:nb, 1:nfieldv) = field(1:nb, 1:nfieldv)
        call vusdfld(nb, nstatev, nfieldv, nprops, 3, nshr, elem_number, 1, 1, 1, step_time, total_time, &
             dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), char_length, &
-            mat%props, state(1:nb, 1:max(1, nstatev)), w%state_mid(1:nb, 1:max(1, nstatev)), &
-            w%field_new(1:nb, 1:nfieldv))
+            mat%props, state(1:nb, 1:ns), w%state_mid(1:nb, 1:ns), w%field_new(1:nb, 1:nfieldv))
     else
-       w%state_mid(1:nb, 1:max(1, nstatev)) = state(1:nb, 1:max(1, nstatev))
-       w%field_new(1:nb, :) = field(1:nb, :)
+       w%state_mid(1:nb, 1:ns) = state(1:nb, 1:ns)
+       w%field_new(1:nb, 1:nf) = field(1:nb, 1:nf)
     end if
     call vumat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
          mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
-         w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, :), stress, w%state_mid(1:nb, :), &
-         e_int, e_inel, w%temp(1:nb), stretch_new, defgrad_new, w%field_new(1:nb, :), &
-         w%stress_new(1:nb, :), w%state_new(1:nb, :), w%e_int_new(1:nb), w%e_inel_new(1:nb))
+         w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, w%state_mid(1:nb, 1:ns), &
+         e_int, e_inel, w%temp(1:nb), stretch_new, defgrad_new, w%field_new(1:nb, 1:nf), &
+         w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
     stress = w%stress_new(1:nb, :)
-    state(1:nb, :) = w%state_new(1:nb, :)
-    field(1:nb, :) = w%field_new(1:nb, :)
+    state(1:nb, 1:ns) = w%state_new(1:nb, 1:ns)
+    field(1:nb, 1:nf) = w%field_new(1:nb, 1:nf)
     e_int = w%e_int_new(1:nb)
     e_inel = w%e_inel_new(1:nb)
   end subroutine call_material

@@ -114,28 +114,27 @@ contains
     real(dp) :: cof(nb, 3, 3), det(nb), gam(nb), xnorm2(nb), cnorm2(nb), change(nb)
     real(dp) :: xnew
     integer :: it, i, j, e
-    logical :: scaled
+    ! Per element: 0 scaled iterations, 1 the final unscaled step, 2 converged (frozen). The
+    ! stopping test is each element's own, so an element's R does not depend on which other
+    ! elements share its block (and results do not depend on the number of MPI ranks).
+    integer :: stage(nb)
 
     r = f
-    scaled = .true.
+    stage = 0
     do it = 1, max_newton
        call cofactor(nb, r, cof, det)
        ! Guard against an exactly singular (collapsed) element: no division by zero.
        det = sign(max(abs(det), tiny(1.0_dp)), det)
-       if (scaled) then
-          xnorm2 = 0.0_dp
-          cnorm2 = 0.0_dp
-          do j = 1, 3
-             do i = 1, 3
-                xnorm2 = xnorm2 + r(:, i, j)**2
-                cnorm2 = cnorm2 + cof(:, i, j)**2
-             end do
+       xnorm2 = 0.0_dp
+       cnorm2 = 0.0_dp
+       do j = 1, 3
+          do i = 1, 3
+             xnorm2 = xnorm2 + r(:, i, j)**2
+             cnorm2 = cnorm2 + cof(:, i, j)**2
           end do
-          ! γ = (‖X⁻¹‖_F / ‖X‖_F)^½ with ‖X⁻¹‖_F = ‖cof X‖_F / |det X|
-          gam = sqrt(sqrt(cnorm2 / max(xnorm2, tiny(1.0_dp))) / abs(det))
-       else
-          gam = 1.0_dp
-       end if
+       end do
+       ! γ = (‖X⁻¹‖_F / ‖X‖_F)^½ with ‖X⁻¹‖_F = ‖cof X‖_F / |det X|; 1 for the final step.
+       gam = merge(sqrt(sqrt(cnorm2 / max(xnorm2, tiny(1.0_dp))) / abs(det)), 1.0_dp, stage == 0)
        change = 0.0_dp
        do j = 1, 3
           do i = 1, 3
@@ -143,14 +142,14 @@ contains
                 ! X⁻ᵀ = cof(X) / det X
                 xnew = 0.5_dp * (gam(e) * r(e, i, j) + cof(e, i, j) / (gam(e) * det(e)))
                 change(e) = change(e) + (xnew - r(e, i, j))**2
-                r(e, i, j) = xnew
+                r(e, i, j) = merge(xnew, r(e, i, j), stage(e) < 2)
              end do
           end do
        end do
-       if (.not. scaled) exit
        ! Near convergence the scaling is switched off for one last plain Newton step, which
        ! restores full quadratic convergence to an orthogonal matrix.
-       if (maxval(change) <= newton_tolerance**2) scaled = .false.
+       stage = merge(stage + 1, stage, stage == 1 .or. (stage == 0 .and. change <= newton_tolerance**2))
+       if (all(stage == 2)) exit
     end do
   end subroutine polar_rotation_3d
 
