@@ -28,6 +28,7 @@ module driver_elements
      real(dp), allocatable :: xe_old(:, :, :), du(:, :, :), xe_mid(:, :, :), xe_new(:, :, :)
      real(dp), allocatable :: bmat_mid(:, :, :), bmat_new(:, :, :), fe(:, :, :), fe_hg(:, :, :)
      real(dp), allocatable :: volume_mid(:), volume_new(:), char_length(:), density(:), modulus(:)
+     real(dp), allocatable :: volume_abs(:)           !< |volume_mid| (no temporary per call)
      real(dp), allocatable :: wave_speed(:), sigma_bv(:), xi(:), e_bv(:), e_hg(:), dt_el(:)
      real(dp), allocatable :: strain_inc(:, :), spin_inc(:, :), strain_corot(:, :), rel_spin(:, :)
      real(dp), allocatable :: r_mid(:, :, :), r_new(:, :, :), f_old(:, :, :), f_new(:, :, :)
@@ -60,7 +61,7 @@ contains
     allocate(w%fe(nmax, ndim, nen), w%fe_hg(nmax, ndim, nen))
     allocate(w%volume_mid(nmax), w%volume_new(nmax), w%char_length(nmax), w%density(nmax))
     allocate(w%modulus(nmax), w%wave_speed(nmax), w%sigma_bv(nmax), w%xi(nmax), w%e_bv(nmax))
-    allocate(w%e_hg(nmax), w%dt_el(nmax), w%reason(nmax))
+    allocate(w%e_hg(nmax), w%dt_el(nmax), w%reason(nmax), w%volume_abs(nmax))
     allocate(w%strain_inc(nmax, ncomp), w%spin_inc(nmax, nshr), w%strain_corot(nmax, ncomp))
     allocate(w%rel_spin(nmax, nshr), w%stress_force(nmax, ncomp))
     allocate(w%r_mid(nmax, ndim, ndim), w%r_new(nmax, ndim, ndim), w%f_old(nmax, ndim, ndim))
@@ -101,19 +102,21 @@ contains
     call vumat_work_init(ws%sets(k)%vumat, nb, ws%ncomp, ws%nshr, ws%nstatev, ws%nfieldv)
   end function work_set
 
-  !> All blocks of this rank for one increment. x_old = x0 + u_n and du = dt v_{n+1/2} per node.
-  !> Sets solver%fe, the element energies, and returns the smallest element stable increment
-  !> (unscaled) with the user number of its element. Stops with the element number, the time and
-  !> the reason when an element inverts or collapses.
-  subroutine element_phase(m, solver, effects, ws, x_old, du, dt, b1, b2, dt_min, dt_elem)
+  !> All blocks of this rank for one increment, from the nodal x_old = x0 + u_n and
+  !> du = solver%du = dt v_{n+1/2}. Sets solver%fe, the element energies, and returns the smallest
+  !> element stable increment (unscaled) with the user number of its element. Stops with the
+  !> element number, the time and the reason when an element inverts or collapses.
+  !> x0 + u is formed per gathered node (the same sum as the nodal array x0 + u it replaces:
+  !> that actual argument cost a node-sized temporary, allocated and freed every increment).
+  subroutine element_phase(m, solver, effects, ws, dt, b1, b2, dt_min, dt_elem)
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
     type(effects_t), intent(inout) :: effects
     type(element_workspace_t), intent(inout) :: ws
-    real(dp), intent(in) :: x_old(:, :), du(:, :), dt, b1, b2
+    real(dp), intent(in) :: dt, b1, b2
     real(dp), intent(out) :: dt_min
     integer, intent(out) :: dt_elem
-    integer :: ib, nb, e, a, i, nd, ne, k, iw
+    integer :: ib, nb, e, nd, ne, iw
 
     dt_min = huge(1.0_dp)
     dt_elem = 0
@@ -126,17 +129,8 @@ contains
        iw = work_set(ws, solver%blocks(ib)%count)
        associate (blk => solver%blocks(ib), w => ws%sets(iw))
          nb = blk%count
-         do a = 1, ne
-            do i = 1, nd
-               do e = 1, nb
-                  k = solver%part%conn(a, blk%first + e - 1)
-                  w%xe_old(e, i, a) = x_old(i, k)
-                  w%du(e, i, a) = du(i, k)
-               end do
-            end do
-         end do
-         w%xe_mid(1:nb, :, :) = w%xe_old(1:nb, :, :) + 0.5_dp * w%du(1:nb, :, :)
-         w%xe_new(1:nb, :, :) = w%xe_old(1:nb, :, :) + w%du(1:nb, :, :)
+         call gather_block(nb, nd, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
+              solver%u, solver%du, w%xe_old, w%du, w%xe_mid, w%xe_new)
          call block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
          do e = 1, nb
             if (w%dt_el(e) < dt_min) then
@@ -149,6 +143,32 @@ contains
     end do
     call effects%stop(effect_elements)
   end subroutine element_phase
+
+  !> Element coordinates x_n = x0 + u_n, x_{n+½}, x_{n+1} and du of a block from the nodal arrays,
+  !> in one pass. A subroutine with explicit-shape dummies: written in place on the work set's
+  !> allocatable components, the loop reloaded their descriptors at every store.
+  subroutine gather_block(nb, nd, ne, conn, x0, u, du_nodes, xe_old, du, xe_mid, xe_new)
+    integer, intent(in) :: nb, nd, ne
+    integer, intent(in) :: conn(ne, nb)
+    real(dp), intent(in) :: x0(nd, *), u(nd, *), du_nodes(nd, *)
+    real(dp), intent(out) :: xe_old(nb, nd, ne), du(nb, nd, ne), xe_mid(nb, nd, ne), xe_new(nb, nd, ne)
+    integer :: e, i, a, k
+    real(dp) :: xo, d
+
+    do a = 1, ne
+       do i = 1, nd
+          do e = 1, nb
+             k = conn(a, e)
+             xo = x0(i, k) + u(i, k)
+             d = du_nodes(i, k)
+             xe_old(e, i, a) = xo
+             du(e, i, a) = d
+             xe_mid(e, i, a) = xo + 0.5_dp * d
+             xe_new(e, i, a) = xo + d
+          end do
+       end do
+    end do
+  end subroutine gather_block
 
   subroutine block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
     type(model_t), intent(in) :: m
@@ -196,7 +216,8 @@ contains
     call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
     call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
     ! Current density at mid-increment, as Abaqus passes it (mass is conserved per element).
-    w%density(1:nb) = blk%mass / abs(w%volume_mid(1:nb))
+    w%volume_abs(1:nb) = abs(w%volume_mid(1:nb))
+    w%density(1:nb) = blk%mass / w%volume_abs(1:nb)
 
     call effects%stop(effect_elements)
     call effects%start(effect_material)
@@ -226,7 +247,7 @@ contains
        call effects%stop(effect_elements)
        call effects%start(effect_bulk_viscosity)
        call bulk_viscosity(nb, nc, w%strain_inc(1:nb, :), dt, w%density(1:nb), w%wave_speed(1:nb), &
-            w%char_length(1:nb), abs(w%volume_mid(1:nb)), b1, b2, w%sigma_bv(1:nb), w%xi(1:nb), &
+            w%char_length(1:nb), w%volume_abs(1:nb), b1, b2, w%sigma_bv(1:nb), w%xi(1:nb), &
             w%e_bv(1:nb))
        do e = 1, 3
           w%stress_force(1:nb, e) = w%stress_force(1:nb, e) + w%sigma_bv(1:nb)

@@ -200,8 +200,7 @@ contains
       call constraint_work(solver, dt_avg, work)
 
       solver%du = dt * solver%v
-      call element_phase(m, solver, effects, ew, solver%x0 + solver%u, solver%du, dt, s%bulk_linear, &
-           s%bulk_quadratic, dt_min, dt_elem)
+      call element_phase(m, solver, effects, ew, dt, s%bulk_linear, s%bulk_quadratic, dt_min, dt_elem)
       solver%u = solver%u + solver%du
       do i = 1, size(solver%rigid)
          solver%rigid(i)%u = solver%rigid(i)%u + dt * solver%rigid(i)%v

@@ -66,7 +66,11 @@ contains
     real(dp), intent(in) :: stretch_old(nb, ncomp), stretch_new(nb, ncomp)
     real(dp), intent(in) :: defgrad_old(nb, ncomp + nshr), defgrad_new(nb, ncomp + nshr)
     real(dp), intent(in) :: log_strain(:, :)
-    real(dp), intent(inout) :: stress(nb, ncomp), state(:, :), field(:, :)
+    ! stress and state are the block's own arrays: allocatable, so the new values can be
+    ! swapped in from the work arrays instead of copied (the copies were most of the memmove
+    ! of a run).
+    real(dp), allocatable, intent(inout) :: stress(:, :), state(:, :)
+    real(dp), intent(inout) :: field(:, :)
     real(dp), intent(inout) :: e_int(nb), e_inel(nb)
     type(vumat_work_t), intent(inout) :: w
     integer :: nstatev, nfieldv, nprops, ns, nf
@@ -89,21 +93,47 @@ contains
        call vusdfld(nb, nstatev, nfieldv, nprops, 3, nshr, elem_number, 1, 1, 1, step_time, total_time, &
             dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), char_length, &
             mat%props, state(1:nb, 1:ns), w%state_mid(1:nb, 1:ns), w%field_new(1:nb, 1:nfieldv))
+       call vumat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
+            mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
+            w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, w%state_mid(1:nb, 1:ns), &
+            e_int, e_inel, w%temp(1:nb), stretch_new, defgrad_new, w%field_new(1:nb, 1:nf), &
+            w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
     else
-       w%state_mid(1:nb, 1:ns) = state(1:nb, 1:ns)
+       ! Without a user field stateOld is the block's state itself (a contiguous (nb, ns) array,
+       ! read only by the VUMAT): no copy through state_mid.
        w%field_new(1:nb, 1:nf) = field(1:nb, 1:nf)
+       call vumat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
+            mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
+            w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, state(1:nb, 1:ns), &
+            e_int, e_inel, w%temp(1:nb), stretch_new, defgrad_new, w%field_new(1:nb, 1:nf), &
+            w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
     end if
-    call vumat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
-         mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
-         w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, w%state_mid(1:nb, 1:ns), &
-         e_int, e_inel, w%temp(1:nb), stretch_new, defgrad_new, w%field_new(1:nb, 1:nf), &
-         w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
-    stress = w%stress_new(1:nb, :)
-    state(1:nb, 1:ns) = w%state_new(1:nb, 1:ns)
+    ! The new stress and state become the block's by swapping allocations when the shapes agree
+    ! (work sets have exactly nb rows; state columns agree unless materials differ in *DEPVAR
+    ! counts); the old arrays become the work arrays the next VUMAT call overwrites.
+    call swap_or_copy(stress, w%stress_new, nb, ncomp)
+    call swap_or_copy(state, w%state_new, nb, ns)
     field(1:nb, 1:nf) = w%field_new(1:nb, 1:nf)
     e_int = w%e_int_new(1:nb)
     e_inel = w%e_inel_new(1:nb)
   end subroutine call_material
+
+  !> block(1:nb, 1:nc) ← work(1:nb, 1:nc): by exchanging the allocations when both have exactly
+  !> that shape, else by copying.
+  subroutine swap_or_copy(block, work, nb, nc)
+    real(dp), allocatable, intent(inout) :: block(:, :), work(:, :)
+    integer, intent(in) :: nb, nc
+    real(dp), allocatable :: held(:, :)
+
+    if (size(block, 1) == nb .and. size(block, 2) == nc .and. size(work, 1) == nb &
+         .and. size(work, 2) == nc) then
+       call move_alloc(block, held)
+       call move_alloc(work, block)
+       call move_alloc(held, work)
+    else
+       block(1:nb, 1:nc) = work(1:nb, 1:nc)
+    end if
+  end subroutine swap_or_copy
 
   !> Abaqus's packaging call: a tiny uniaxial strain increment from a stress-free state at
   !> stepTime = totalTime = 0; Δσ11/Δε11 is the P-wave modulus λ + 2G that sets the wave

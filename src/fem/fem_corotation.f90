@@ -67,7 +67,25 @@ contains
     real(dp), intent(in) :: xe(nb, ndim, nen)
     real(dp), intent(out) :: f(nb, ndim, ndim)
     integer :: i, j, n, e
+    real(dp) :: x2, x3, x4, y2, y3, y4
 
+    if (ndim == 2 .and. nen == 4) then
+       ! CPE4R: one pass with the sums of the general loop below in the same order (bitwise the
+       ! same F), instead of zeroing F and updating it three times.
+       do e = 1, nb
+          x2 = xe(e, 1, 2) - xe(e, 1, 1)
+          x3 = xe(e, 1, 3) - xe(e, 1, 1)
+          x4 = xe(e, 1, 4) - xe(e, 1, 1)
+          y2 = xe(e, 2, 2) - xe(e, 2, 1)
+          y3 = xe(e, 2, 3) - xe(e, 2, 1)
+          y4 = xe(e, 2, 4) - xe(e, 2, 1)
+          f(e, 1, 1) = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
+          f(e, 2, 1) = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
+          f(e, 1, 2) = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
+          f(e, 2, 2) = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       end do
+       return
+    end if
     f = 0.0_dp
     do n = 2, nen
        do j = 1, ndim
@@ -91,17 +109,22 @@ contains
     integer, intent(in) :: nb, ndim
     real(dp), intent(in) :: f(nb, ndim, ndim)
     real(dp), intent(out) :: r(nb, ndim, ndim)
-    real(dp) :: c(nb), s(nb), nrm(nb)
+    real(dp) :: c, s, nrm
+    integer :: e
 
     if (ndim == 2) then
-       c = f(:, 1, 1) + f(:, 2, 2)
-       s = f(:, 2, 1) - f(:, 1, 2)
-       ! ‖·‖² = ‖F‖² + 2 det F > 0 for a non-inverted element; the guard only avoids 0/0.
-       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
-       r(:, 1, 1) = c / nrm
-       r(:, 2, 1) = s / nrm
-       r(:, 1, 2) = -s / nrm
-       r(:, 2, 2) = c / nrm
+       ! One loop with scalars: block-sized automatic arrays are heap-allocated by gfortran,
+       ! a malloc/free pair each per call.
+       do e = 1, nb
+          c = f(e, 1, 1) + f(e, 2, 2)
+          s = f(e, 2, 1) - f(e, 1, 2)
+          ! ‖·‖² = ‖F‖² + 2 det F > 0 for a non-inverted element; the guard only avoids 0/0.
+          nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
+          r(e, 1, 1) = c / nrm
+          r(e, 2, 1) = s / nrm
+          r(e, 1, 2) = -s / nrm
+          r(e, 2, 2) = c / nrm
+       end do
     else
        call polar_rotation_3d(nb, f, r)
     end if
@@ -213,9 +236,23 @@ contains
     logical, intent(in) :: transposed
     real(dp), intent(in) :: a(nb, ncomp)
     real(dp), intent(out) :: b(nb, ncomp)
+
+    if (ndim == 2) then
+       call rotate_symmetric_2d(nb, r, transposed, a, b)
+    else
+       call rotate_symmetric_nd(nb, ndim, ncomp, r, transposed, a, b)
+    end if
+  end subroutine rotate_symmetric
+
+  !> rotate_symmetric on block temporaries, any ndim (used for 3D).
+  pure subroutine rotate_symmetric_nd(nb, ndim, ncomp, r, transposed, a, b)
+    integer, intent(in) :: nb, ndim, ncomp
+    real(dp), intent(in) :: r(nb, ndim, ndim)
+    logical, intent(in) :: transposed
+    real(dp), intent(in) :: a(nb, ncomp)
+    real(dp), intent(out) :: b(nb, ncomp)
     real(dp) :: full(nb, ndim, ndim), t(nb, ndim, ndim), q(nb, ndim, ndim)
     integer :: i, j, k, c
-
     ! q = R (b = q a qᵀ) or Rᵀ
     if (transposed) then
        do j = 1, ndim
@@ -268,7 +305,45 @@ contains
           b(:, c) = 0.5_dp * (full(:, sym_i(c), sym_j(c)) + full(:, sym_j(c), sym_i(c)))
        end do
     end if
-  end subroutine rotate_symmetric
+  end subroutine rotate_symmetric_nd
+
+  !> rotate_symmetric for ndim = 2 as one loop on scalars (no block temporaries, one pass). The
+  !> sums are those of the general form in the same order, starting from 0 as it does, so the
+  !> result is the same to the bit.
+  pure subroutine rotate_symmetric_2d(nb, r, transposed, a, b)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: r(nb, 2, 2)
+    logical, intent(in) :: transposed
+    real(dp), intent(in) :: a(nb, 4)
+    real(dp), intent(out) :: b(nb, 4)
+    real(dp) :: q11, q12, q21, q22, a11, a22, a12, t11, t12, t21, t22, u12, u21
+    integer :: e, i, j
+
+    ! q = R or Rᵀ: q12 = r(:, i, j), q21 = r(:, j, i). Chosen outside the loop, which then
+    ! vectorises (a branch inside kept it scalar).
+    i = merge(2, 1, transposed)
+    j = 3 - i
+    do e = 1, nb
+       q11 = r(e, 1, 1)
+       q22 = r(e, 2, 2)
+       q12 = r(e, i, j)
+       q21 = r(e, j, i)
+       a11 = a(e, 1)
+       a22 = a(e, 2)
+       a12 = a(e, 4)
+       ! t = a qᵀ, then b = q t
+       t11 = (0.0_dp + a11 * q11) + a12 * q12
+       t12 = (0.0_dp + a11 * q21) + a12 * q22
+       t21 = (0.0_dp + a12 * q11) + a22 * q12
+       t22 = (0.0_dp + a12 * q21) + a22 * q22
+       b(e, 1) = (0.0_dp + q11 * t11) + q12 * t21
+       b(e, 2) = (0.0_dp + q21 * t12) + q22 * t22
+       b(e, 3) = a(e, 3)
+       u12 = (0.0_dp + q11 * t12) + q12 * t22
+       u21 = (0.0_dp + q21 * t11) + q22 * t21
+       b(e, 4) = 0.5_dp * (u12 + u21)
+    end do
+  end subroutine rotate_symmetric_2d
 
   !> relSpinInc: ΔW − ΔΩ in the corotational frame (Rᵀ_{n+½} applied to the axial vector).
   !> spin_inc is the global material spin increment of the element kinematics (axial vector of
@@ -278,6 +353,30 @@ contains
   !> has relSpinInc = 0 to round-off.
   !> Order (nb, nshr): 2D ω3 (about the out-of-plane axis); 3D (ω1, ω2, ω3) = (W32, W13, W21).
   pure subroutine relative_spin(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
+    integer, intent(in) :: nb, ndim
+    real(dp), intent(in) :: spin_inc(nb, 2 * ndim - 3)
+    real(dp), intent(in) :: r_old(nb, ndim, ndim), r_new(nb, ndim, ndim), r_mid(nb, ndim, ndim)
+    real(dp), intent(out) :: rel_spin(nb, 2 * ndim - 3)
+    real(dp) :: d11, d22, d12, d21
+    integer :: e
+
+    if (ndim == 2) then
+       ! One loop on scalars (no block temporaries); the same sums in the same order as below.
+       do e = 1, nb
+          d11 = (0.0_dp + r_new(e, 1, 1) * r_old(e, 1, 1)) + r_new(e, 1, 2) * r_old(e, 1, 2)
+          d22 = (0.0_dp + r_new(e, 2, 1) * r_old(e, 2, 1)) + r_new(e, 2, 2) * r_old(e, 2, 2)
+          d12 = (0.0_dp + r_new(e, 1, 1) * r_old(e, 2, 1)) + r_new(e, 1, 2) * r_old(e, 2, 2)
+          d21 = (0.0_dp + r_new(e, 2, 1) * r_old(e, 1, 1)) + r_new(e, 2, 2) * r_old(e, 1, 2)
+          ! 1 + tr ΔR of the 3-D embedding (ΔR33 = 1)
+          rel_spin(e, 1) = spin_inc(e, 1) - 2.0_dp * (d21 - d12) / (2.0_dp + d11 + d22)
+       end do
+    else
+       call relative_spin_nd(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
+    end if
+  end subroutine relative_spin
+
+  !> relative_spin on block temporaries, any ndim (used for 3D).
+  pure subroutine relative_spin_nd(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
     integer, intent(in) :: nb, ndim
     real(dp), intent(in) :: spin_inc(nb, 2 * ndim - 3)
     real(dp), intent(in) :: r_old(nb, ndim, ndim), r_new(nb, ndim, ndim), r_mid(nb, ndim, ndim)
@@ -309,7 +408,7 @@ contains
                            + r_mid(:, 3, i) * w(:, 3)
        end do
     end if
-  end subroutine relative_spin
+  end subroutine relative_spin_nd
 
   !> F in the VUMAT layout (nb, ndir + 2 nshr): 2D F11, F22, F33 (= 1), F12, F21;
   !> 3D F11, F22, F33, F12, F23, F31, F21, F32, F13.
@@ -342,6 +441,29 @@ contains
     integer, intent(in) :: nb, ndim
     real(dp), intent(in) :: r(nb, ndim, ndim), f(nb, ndim, ndim)
     real(dp), intent(out) :: stretch(nb, 2 * ndim)
+    real(dp) :: u12, u21
+    integer :: e
+
+    if (ndim == 2) then
+       ! One loop on scalars (no block temporary); the same sums in the same order as below.
+       do e = 1, nb
+          stretch(e, 1) = (0.0_dp + r(e, 1, 1) * f(e, 1, 1)) + r(e, 2, 1) * f(e, 2, 1)
+          stretch(e, 2) = (0.0_dp + r(e, 1, 2) * f(e, 1, 2)) + r(e, 2, 2) * f(e, 2, 2)
+          stretch(e, 3) = 1.0_dp
+          u12 = (0.0_dp + r(e, 1, 1) * f(e, 1, 2)) + r(e, 2, 1) * f(e, 2, 2)
+          u21 = (0.0_dp + r(e, 1, 2) * f(e, 1, 1)) + r(e, 2, 2) * f(e, 2, 1)
+          stretch(e, 4) = 0.5_dp * (u12 + u21)
+       end do
+    else
+       call vumat_stretch_nd(nb, ndim, r, f, stretch)
+    end if
+  end subroutine vumat_stretch
+
+  !> vumat_stretch on a block temporary, any ndim (used for 3D).
+  pure subroutine vumat_stretch_nd(nb, ndim, r, f, stretch)
+    integer, intent(in) :: nb, ndim
+    real(dp), intent(in) :: r(nb, ndim, ndim), f(nb, ndim, ndim)
+    real(dp), intent(out) :: stretch(nb, 2 * ndim)
     real(dp) :: u(nb, ndim, ndim)
     integer :: i, j, k, c
 
@@ -366,5 +488,5 @@ contains
           stretch(:, c) = 0.5_dp * (u(:, sym_i(c), sym_j(c)) + u(:, sym_j(c), sym_i(c)))
        end do
     end if
-  end subroutine vumat_stretch
+  end subroutine vumat_stretch_nd
 end module fem_corotation

@@ -36,27 +36,30 @@ contains
     real(dp), intent(in) :: thickness(nb)
     real(dp), intent(out) :: volume(nb)
     real(dp), intent(out) :: bmat(nb, 2, 4)
-    real(dp) :: dx(nb), dy(nb), ex(nb), ey(nb), r2a(nb)
+    real(dp) :: dx, dy, ex, ey, area, r2a
+    integer :: e
 
-    ! Whole-block array statements on local copies: a single loop reading xe and writing
-    ! nine output streams exceeds gfortran's alias-check budget and stays scalar.
-    dx = xe(:, 1, 3) - xe(:, 1, 1)
-    dy = xe(:, 2, 3) - xe(:, 2, 1)
-    ex = xe(:, 1, 4) - xe(:, 1, 2)
-    ey = xe(:, 2, 4) - xe(:, 2, 2)
-    ! r2a holds the area A first, then 1/(2A)
-    r2a = 0.5_dp * (dx * ey - dy * ex)
-    volume = thickness * r2a
-    ! A degenerate element (A = 0) is caught by the inversion check; avoid 1/0 here.
-    r2a = 1.0_dp / sign(max(abs(2.0_dp * r2a), tiny(1.0_dp)), r2a)
-    bmat(:, 1, 1) = -ey * r2a
-    bmat(:, 1, 2) = dy * r2a
-    bmat(:, 1, 3) = ey * r2a
-    bmat(:, 1, 4) = -dy * r2a
-    bmat(:, 2, 1) = ex * r2a
-    bmat(:, 2, 2) = -dx * r2a
-    bmat(:, 2, 3) = -ex * r2a
-    bmat(:, 2, 4) = dx * r2a
+    ! One loop on scalars. (Whole-block array statements on local copies vectorised, but the
+    ! five block-sized automatic arrays are heap-allocated by gfortran: five malloc/free pairs
+    ! per call, and five extra passes, cost more than the loop's scalar code.)
+    do e = 1, nb
+       dx = xe(e, 1, 3) - xe(e, 1, 1)
+       dy = xe(e, 2, 3) - xe(e, 2, 1)
+       ex = xe(e, 1, 4) - xe(e, 1, 2)
+       ey = xe(e, 2, 4) - xe(e, 2, 2)
+       area = 0.5_dp * (dx * ey - dy * ex)
+       volume(e) = thickness(e) * area
+       ! A degenerate element (A = 0) is caught by the inversion check; avoid 1/0 here.
+       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
+       bmat(e, 1, 1) = -ey * r2a
+       bmat(e, 1, 2) = dy * r2a
+       bmat(e, 1, 3) = ey * r2a
+       bmat(e, 1, 4) = -dy * r2a
+       bmat(e, 2, 1) = ex * r2a
+       bmat(e, 2, 2) = -dx * r2a
+       bmat(e, 2, 3) = -ex * r2a
+       bmat(e, 2, 4) = dx * r2a
+    end do
   end subroutine cpe4r_geometry
 
   !> Characteristic length L_e = A / (longest edge): the element height across its longest
