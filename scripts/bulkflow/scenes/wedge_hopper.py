@@ -67,13 +67,14 @@ class WedgeHopper:
     wall_friction: float = 5.0       #: φw, μ = tan φw (wall and outlet plate)
     # loading and time
     gravity: float = 9.81
-    ramp: float = 0.6                #: smooth-step rise time of gravity
+    ramp: float = 0.6                #: smooth-step rise time of gravity (0: gravity at once)
     hold: float = 0.4                #: settling time after the ramp
     dt_scale: float | None = None    #: *DYNAMIC, SCALE FACTOR (None: 1)
     fixed_dt: float | None = None    #: DIRECT USER CONTROL increment (None: stable increment)
     field_frames: int = 10
     history_points: int = 200
     restart: bool = False
+    initial_k: float | None = None   #: geostatic initial stress: σv = −ρ g depth, σh = σzz = k σv
     title: str = ""
 
     # ---- derived geometry -------------------------------------------------------------------
@@ -259,7 +260,10 @@ class WedgeHopper:
         L += ["*SOLID SECTION, ELSET=FILL, MATERIAL=" + ("ELASTIC-FILL" if self.elastic else "MC-FILL")]
         L += ["1." if self.dim == 2 else ""]
         L += self.material_lines()
-        L += ["*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP", f"0., 0., {fmt(self.ramp)}, 1."]
+        if self.ramp > 0:
+            L += ["*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP", f"0., 0., {fmt(self.ramp)}, 1."]
+        if self.initial_k is not None:
+            L += self.initial_stress_lines(nodes, elems)
         # symmetry
         L += ["*BOUNDARY", "AXIS, XSYMM"]
         if self.dim == 3:
@@ -308,17 +312,36 @@ class WedgeHopper:
         else:
             L += ["*DYNAMIC, EXPLICIT", f", {fmt(period)}"]
         L += ["*BULK VISCOSITY", "0.06, 1.2"]
-        L += ["*DLOAD, AMPLITUDE=RAMP", f"FILL, GRAV, {fmt(self.gravity)}, 0., -1." + (", 0." if self.dim == 3 else "")]
+        L += ["*DLOAD" + (", AMPLITUDE=RAMP" if self.ramp > 0 else ""), f"FILL, GRAV, {fmt(self.gravity)}, 0., -1." + (", 0." if self.dim == 3 else "")]
         if contact:
             L += ["*CONTACT PAIR, INTERACTION=WALLFRICTION", "FILL_WALL, WALL", "FILL_BOTTOM, PLATE"]
         if self.field_frames > 0:
             L += [f"*OUTPUT, FIELD, NUMBER INTERVAL={self.field_frames}", "*NODE OUTPUT", "U, V",
-                  "*ELEMENT OUTPUT", "S, LE, PEEQ" + (", SDV" if not self.elastic else "")]
-        L += [f"*OUTPUT, HISTORY, NUMBER INTERVAL={self.history_points}", "*ENERGY OUTPUT"]
+                  "*ELEMENT OUTPUT", "S, LE" + (", SDV" if not self.elastic else "")]   # PEEQ is SDV1
+        L += [f"*OUTPUT, HISTORY, NUMBER INTERVAL={self.history_points}", "*ENERGY OUTPUT, VARIABLE=PRESELECT"]
         if self.restart:
             L += ["*RESTART, WRITE, NUMBER INTERVAL=1"]
         L += ["*END STEP", ""]
         return "\n".join(L)
+
+    def initial_stress_lines(self, nodes, elems) -> list[str]:
+        """Element sets of element rows and a geostatic *INITIAL CONDITIONS, TYPE=STRESS: the
+        vertical stress of the row's mean centroid depth below the fill top, the horizontal and
+        out-of-plane stresses k times it (tension positive, as Abaqus)."""
+        nx = self.n_across
+        rows = len(self.row_coordinates()) - 1
+        yc = nodes[elems][:, :, 1].mean(axis=1)
+        per_layer = nx * rows
+        L = []
+        cond = ["*INITIAL CONDITIONS, TYPE=STRESS"]
+        for j in range(rows):
+            ids = [k * per_layer + j * nx + i for k in range(self.n_depth if self.dim == 3 else 1) for i in range(nx)]
+            depth = self.top_y - float(np.mean(yc[ids]))
+            sv = -self.density * self.gravity * max(depth, 0.0)
+            L += elset(f"ROW{j + 1}", ids)
+            comps = [self.initial_k * sv, sv, self.initial_k * sv, 0.0] + ([0.0, 0.0] if self.dim == 3 else [])
+            cond.append(f"ROW{j + 1}, " + ", ".join(f"{c:.6g}" for c in comps))
+        return L + cond
 
     def write(self, path: str | Path) -> Path:
         path = Path(path)
@@ -329,8 +352,10 @@ class WedgeHopper:
     # ---- CalculiX --------------------------------------------------------------------------
     def calculix_text(self, increments: int | None = None, dt: float | None = None) -> str:
         """The same mesh, elastic material, pinned walls, symmetry and gravity for CalculiX's
-        explicit solver (`*DYNAMIC, EXPLICIT`), with a fixed increment `dt` and `increments`
-        increments; outputs only at the end."""
+        explicit solver (`*DYNAMIC, EXPLICIT`, NLGEOM), over `increments` × `dt` (default: the
+        scene's period). CalculiX chooses its own constant increment (its "Volumetric COURANT"
+        stable increment, printed as "SELECTED time increment"); `DIRECT` is not used because
+        CalculiX 2.20 hangs with `*DYNAMIC, EXPLICIT, DIRECT`. No field or print output."""
         if self.walls != "pinned" or not self.elastic:
             raise ValueError("the CalculiX twin exists for elastic scenes with pinned walls only")
         nodes, elems, sets = self.mesh()
@@ -349,13 +374,14 @@ class WedgeHopper:
         L += ["*MATERIAL, NAME=FILLMAT", "*ELASTIC", f"{fmt(self.young)}, {fmt(self.poisson)}",
               "*DENSITY", fmt(self.density)]
         L += ["*SOLID SECTION, ELSET=FILL, MATERIAL=FILLMAT"] + (["1."] if self.dim == 2 else [])
-        L += ["*AMPLITUDE, NAME=RAMP", f"0., 0., {fmt(self.ramp)}, 1., {fmt(self.ramp + self.hold + period)}, 1."]
+        if self.ramp > 0:
+            L += ["*AMPLITUDE, NAME=RAMP", f"0., 0., {fmt(self.ramp)}, 1., {fmt(self.ramp + self.hold + period)}, 1."]
         L += ["*BOUNDARY", "AXIS, 1, 1", "WALLN, 1, 2" if self.dim == 2 else "WALLN, 1, 3",
               "BOTTOMN, 1, 2" if self.dim == 2 else "BOTTOMN, 1, 3"]
         if self.dim == 3:
             L += ["BACK, 3, 3", "FRONT, 3, 3"]
-        L += ["*STEP, NLGEOM, INC=10000000", "*DYNAMIC, EXPLICIT, DIRECT", f"{dt:.9g}, {period:.9g}",
-              "*DLOAD, AMPLITUDE=RAMP", f"FILL, GRAV, {fmt(self.gravity)}, 0., -1., 0.",
+        L += ["*STEP, NLGEOM, INC=10000000", "*DYNAMIC, EXPLICIT", f"{dt:.9g}, {period:.9g}",
+              "*DLOAD" + (", AMPLITUDE=RAMP" if self.ramp > 0 else ""), f"FILL, GRAV, {fmt(self.gravity)}, 0., -1., 0.",
               "*NODE FILE, FREQUENCY=0", "*EL FILE, FREQUENCY=0",
               "*END STEP", ""]
         return "\n".join(L)
@@ -414,7 +440,9 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--walls", choices=["contact", "pinned"], default=d.walls)
     g.add_argument("--wall-friction", type=float, default=d.wall_friction, help="φw (deg)")
     g.add_argument("--gravity", type=float, default=d.gravity)
-    g.add_argument("--ramp", type=float, default=d.ramp, help="smooth-step rise time (s)")
+    g.add_argument("--ramp", type=float, default=d.ramp, help="smooth-step rise time (s); 0: gravity at once")
+    g.add_argument("--initial-k", type=float, default=None,
+                   help="geostatic initial stress, horizontal/vertical ratio k (default: none)")
     g.add_argument("--hold", type=float, default=d.hold, help="settling time after the ramp (s)")
     g.add_argument("--dt-scale", type=float, default=None)
     g.add_argument("--fixed-dt", type=float, default=None)
@@ -434,7 +462,8 @@ def main(argv=None) -> int:
                         cohesion=a.cohesion, dilation_table=THESIS_DILATION_TABLE if a.dilation_table else None,
                         elastic=a.elastic, walls=a.walls, wall_friction=a.wall_friction, gravity=a.gravity,
                         ramp=a.ramp, hold=a.hold, dt_scale=a.dt_scale, fixed_dt=a.fixed_dt,
-                        field_frames=a.field_frames, history_points=a.history_points, title=a.title)
+                        field_frames=a.field_frames, history_points=a.history_points, title=a.title,
+                        initial_k=a.initial_k)
     path = scene.write(a.output)
     print(f"{path}: {scene.n_elements()} {'CPE4R' if scene.dim == 2 else 'C3D8R'} elements, "
           f"stable dt ~ {scene.stable_dt():.3g} s, {scene.ramp + scene.hold:g} s "
