@@ -7,7 +7,7 @@ module driver_output
   use material_kinds, only: dp
   use model, only: model_t
   use model_steps, only: field_output_t, history_output_t
-  use parallel_partition, only: partition_t
+  use parallel_partition, only: partition_t, local_node_index
   use parallel_assembly, only: global_sum
   use driver_solver, only: solver_t
   use output_hdf5, only: field_writer_t, field_writer_open, field_writer_frame, field_writer_end_frame, &
@@ -414,7 +414,7 @@ contains
             acc = 0
             do i = 1, size(m%nsets(h%nset)%members)
                g = m%nsets(h%nset)%members(i)
-               li = local_index(solver, g)
+               li = local_node_index(solver%part, g)
                if (li == 0) cycle
                if (.not. solver%part%node_owned(li)) cycle
                select case (var(1:len_trim(var) - 1))
@@ -441,27 +441,6 @@ contains
        end associate
     end do
   end subroutine set_values
-
-  pure integer function local_index(solver, g)
-    type(solver_t), intent(in) :: solver
-    integer, intent(in) :: g
-    integer :: lo, hi, mid
-
-    local_index = 0
-    lo = 1
-    hi = solver%n_nodes
-    do while (lo <= hi)
-       mid = (lo + hi) / 2
-       if (solver%part%node_global(mid) == g) then
-          local_index = mid
-          return
-       else if (solver%part%node_global(mid) < g) then
-          lo = mid + 1
-       else
-          hi = mid - 1
-       end if
-    end do
-  end function local_index
 
   !> Connectivity of the local elements in global node indices, as the field writer wants it.
   function global_connectivity(part) result(conn)
