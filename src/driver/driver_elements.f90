@@ -68,6 +68,13 @@ contains
     allocate(w%f_new(nmax, ndim, ndim))
     allocate(w%stretch_old(nmax, ncomp), w%stretch_new(nmax, ncomp))
     allocate(w%defgrad_old(nmax, ncomp + nshr), w%defgrad_new(nmax, ncomp + nshr))
+    ! Identity F and U for blocks whose VUMAT does not read them (they are not recomputed).
+    w%defgrad_old = 0
+    w%defgrad_old(:, 1:3) = 1
+    w%defgrad_new = w%defgrad_old
+    w%stretch_old = 0
+    w%stretch_old(:, 1:3) = 1
+    w%stretch_new = w%stretch_old
     w%e_bv = 0
     w%e_hg = 0
   end subroutine element_work_init
@@ -210,11 +217,13 @@ contains
     call corotational_increment(nb, nd, ne, blk%bmat_ref, w%xe_mid(1:nb, :, :), w%xe_new(1:nb, :, :), &
          w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), blk%rotation, w%r_mid(1:nb, :, :), &
          w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%strain_corot(1:nb, :), w%rel_spin(1:nb, :))
-    call deformation_gradient(nb, nd, ne, blk%bmat_ref, w%xe_old(1:nb, :, :), w%f_old(1:nb, :, :))
-    call vumat_defgrad(nb, nd, w%f_old(1:nb, :, :), w%defgrad_old(1:nb, :))
-    call vumat_defgrad(nb, nd, w%f_new(1:nb, :, :), w%defgrad_new(1:nb, :))
-    call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
-    call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
+    if (blk%vumat_needs_kinematics) then
+       call deformation_gradient(nb, nd, ne, blk%bmat_ref, w%xe_old(1:nb, :, :), w%f_old(1:nb, :, :))
+       call vumat_defgrad(nb, nd, w%f_old(1:nb, :, :), w%defgrad_old(1:nb, :))
+       call vumat_defgrad(nb, nd, w%f_new(1:nb, :, :), w%defgrad_new(1:nb, :))
+       call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
+       call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
+    end if
     ! Current density at mid-increment, as Abaqus passes it (mass is conserved per element).
     w%volume_abs(1:nb) = abs(w%volume_mid(1:nb))
     w%density(1:nb) = blk%mass / w%volume_abs(1:nb)

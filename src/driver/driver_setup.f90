@@ -13,6 +13,7 @@ module driver_setup
   use fem_c3d8r, only: c3d8r_geometry, c3d8r_internal_force
   use fem_corotation, only: identity_rotation
   use fem_mass, only: lumped_mass
+  use material_props, only: model_from_name, model_unknown
   implicit none
   private
 
@@ -178,6 +179,7 @@ contains
       blk%e_int = 0
       blk%e_inel = 0
       blk%wave_modulus = modulus
+      blk%vumat_needs_kinematics = model_from_name(mat%vumat_name) == model_unknown
     end associate
   end subroutine setup_block
 

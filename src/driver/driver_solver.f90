@@ -36,6 +36,9 @@ module driver_solver
      real(dp), allocatable :: sigma_bv(:)             !< bulk-viscosity pressure of the last increment
      real(dp), allocatable :: force_hg(:, :, :)       !< (count, ndim, nen) hourglass forces at t_n
      real(dp) :: wave_modulus = 0                     !< λ + 2G from the packaging call
+     !> Pass F and U (defgradOld/New, stretchOld/New) to the VUMAT. Our own materials never
+     !> read them, so blocks of our materials skip computing them (an effect not asked for).
+     logical :: vumat_needs_kinematics = .true.
   end type element_block_t
 
   type, public :: rigid_body_t
