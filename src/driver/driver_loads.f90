@@ -6,6 +6,7 @@ module driver_loads
   use material_kinds, only: dp
   use model, only: model_t
   use model_steps, only: bc_velocity
+  use model_sets, only: sorted_position
   use parallel_partition, only: partition_t, local_node_index, local_elem_index
   use parallel_assembly, only: assemble_element_vectors
   use driver_solver, only: solver_t
@@ -104,7 +105,7 @@ contains
                  do e = 1, blk%count
                     le = blk%first + e - 1
                     if (s%gravity(g)%elset > 0) then
-                       if (.not. in_set(m%elsets(s%gravity(g)%elset)%members, part%elem_global(le))) cycle
+                       if (sorted_position(m%elsets(s%gravity(g)%elset)%members, part%elem_global(le)) == 0) cycle
                     end if
                     do a = 1, solver%nen
                        fe(le, 1, a) = blk%mass(e) / solver%nen
@@ -162,26 +163,6 @@ contains
     owned = owned(1:no)
     others = others(1:nt)
   end subroutine split_slaves
-
-  pure logical function in_set(members, g)
-    integer, intent(in) :: members(:), g
-    integer :: lo, hi, mid
-
-    in_set = .false.
-    lo = 1
-    hi = size(members)
-    do while (lo <= hi)
-       mid = (lo + hi) / 2
-       if (members(mid) == g) then
-          in_set = .true.
-          return
-       else if (members(mid) < g) then
-          lo = mid + 1
-       else
-          hi = mid - 1
-       end if
-    end do
-  end function in_set
 
   !> Overwrite v_{n+1/2} on prescribed dofs: a velocity BC gives value·A(t_{n+1/2}); a
   !> displacement BC the velocity that reaches value·A(t_{n+1}) at the end of the increment.

@@ -3,6 +3,7 @@
 !> and the user's node and element numbers for messages and output.
 module model_mesh
   use material_kinds, only: dp
+  use model_sets, only: sorted_position
   implicit none
   private
 
@@ -32,33 +33,13 @@ contains
   pure integer function node_index(this, id)
     class(mesh_t), intent(in) :: this
     integer, intent(in) :: id
-    node_index = sorted_find(this%node_id(1:this%n_nodes), id)
+    node_index = sorted_position(this%node_id(1:this%n_nodes), id)
   end function node_index
 
   !> Internal index of a user element number, 0 when absent (elem_id ascending).
   pure integer function elem_index(this, id)
     class(mesh_t), intent(in) :: this
     integer, intent(in) :: id
-    elem_index = sorted_find(this%elem_id(1:this%n_elems), id)
+    elem_index = sorted_position(this%elem_id(1:this%n_elems), id)
   end function elem_index
-
-  pure integer function sorted_find(list, id)
-    integer, intent(in) :: list(:), id
-    integer :: lo, hi, mid
-
-    sorted_find = 0
-    lo = 1
-    hi = size(list)
-    do while (lo <= hi)
-       mid = (lo + hi) / 2
-       if (list(mid) == id) then
-          sorted_find = mid
-          return
-       else if (list(mid) < id) then
-          lo = mid + 1
-       else
-          hi = mid - 1
-       end if
-    end do
-  end function sorted_find
 end module model_mesh

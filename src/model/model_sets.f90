@@ -10,7 +10,7 @@ module model_sets
      integer, allocatable :: members(:)       !< internal indices, ascending, unique
   end type index_set_t
 
-  public :: find_set
+  public :: find_set, sorted_position
 
 contains
 
@@ -29,4 +29,26 @@ contains
        end if
     end do
   end function find_set
+
+  !> Position of `value` in an ascending list of integers (set members, node or element
+  !> numbers, global indices), 0 if it is not there. Binary search.
+  pure integer function sorted_position(list, value) result(pos)
+    integer, intent(in) :: list(:), value
+    integer :: lo, hi, mid
+
+    pos = 0
+    lo = 1
+    hi = size(list)
+    do while (lo <= hi)
+       mid = lo + (hi - lo) / 2
+       if (list(mid) == value) then
+          pos = mid
+          return
+       else if (list(mid) < value) then
+          lo = mid + 1
+       else
+          hi = mid - 1
+       end if
+    end do
+  end function sorted_position
 end module model_sets

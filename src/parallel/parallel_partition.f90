@@ -21,6 +21,7 @@ module parallel_partition
   use material_kinds, only: dp
   use model, only: model_t
   use model_mesh, only: mesh_t
+  use model_sets, only: sorted_position
   use error_report, only: error_t, raise_error
   use parallel_comm, only: comm_rank, comm_size, comm_min, comm_max, comm_sum
   implicit none
@@ -437,14 +438,14 @@ contains
   pure integer function local_node_index(part, global)
     type(partition_t), intent(in) :: part   !< partition
     integer, intent(in) :: global           !< global node index
-    local_node_index = binary_search(part%node_global, global)
+    local_node_index = sorted_position(part%node_global, global)
   end function local_node_index
 
   !> Local index of global element `global` on this rank, 0 if it is another rank's.
   pure integer function local_elem_index(part, global)
     type(partition_t), intent(in) :: part   !< partition
     integer, intent(in) :: global           !< global element index
-    local_elem_index = binary_search(part%elem_global, global)
+    local_elem_index = sorted_position(part%elem_global, global)
   end function local_elem_index
 
   !> Local indices of the nodes this rank owns (writes to output, counts in nodal sums).
@@ -479,25 +480,4 @@ contains
          ' on a rank), neighbours <= ', maxima(3)
     text = trim(buf)
   end function partition_summary
-
-  pure integer function binary_search(list, x) result(pos)
-    integer, intent(in) :: list(:), x
-    integer :: lo, hi, mid
-
-    pos = 0
-    lo = 1
-    hi = size(list)
-    do while (lo <= hi)
-       mid = lo + (hi - lo) / 2
-       if (list(mid) == x) then
-          pos = mid
-          return
-       else if (list(mid) < x) then
-          lo = mid + 1
-       else
-          hi = mid - 1
-       end if
-    end do
-  end function binary_search
-
 end module parallel_partition
