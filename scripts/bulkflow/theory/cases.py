@@ -67,7 +67,7 @@ class Case:
     def material(self, reading: str = "c0") -> Material:
         return Material(rho=self.rho, phi_deg=self.phi_deg, phi_w_deg=self.phi_w_deg, k=self.k,
                         fc0=self.fc0(reading), E=self.E, nu=self.nu,
-                        name=f"{self.name} (reading {reading})")
+                        name=self.name + (f" (reading {reading})" if len(self.readings) > 1 else ""))
 
     def hopper(self, height: float | None = None, outlet_width: float | None = None) -> Hopper:
         return Hopper(theta_deg=self.theta_deg, height=self.height if height is None else height,

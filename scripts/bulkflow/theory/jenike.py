@@ -189,7 +189,7 @@ def _shoot(geometry, S, s0, theta_rad, dense=False):
 
 
 def radial_stress_field(delta_deg: float, phi_w_deg: float, theta_deg: float,
-                        geometry: str = "plane", s0_range=(0.05, 50.0)) -> RadialField:
+                        geometry: str = "plane", s0_range=(1e-3, 50.0)) -> RadialField:
     """Jenike's passive radial stress field by shooting on s(0) (hopper_theory.md §c.4 route 1).
 
     Equilibrium in polar coordinates with p = ρ g r s(t), σ₁,₂ = p(1 ± sin δ) (Coulomb material
@@ -207,7 +207,7 @@ def radial_stress_field(delta_deg: float, phi_w_deg: float, theta_deg: float,
             return math.nan
         return sol.y[1, -1] - target
 
-    grid = np.geomspace(*s0_range, 120)
+    grid = np.geomspace(*s0_range, 160)
     vals = [miss(s) for s in grid]
     root = None
     for i in range(len(grid) - 1):
