@@ -89,8 +89,9 @@ CASES = {
 
 
 def case(key: str) -> Case:
+    lookup = {k.lower(): v for k, v in CASES.items()}
     try:
-        return CASES[key if key in CASES else key.lower()]
+        return lookup[key.lower()]
     except KeyError:
         raise KeyError(f"unknown case {key!r}; one of {list(CASES)}") from None
 

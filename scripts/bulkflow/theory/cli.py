@@ -149,8 +149,8 @@ def _extras(h, m, est, args):
     return ex
 
 
-def print_estimates(h, m, est, ex, sweep=None, out=sys.stdout):
-    w = out.write
+def print_estimates(h, m, est, ex, sweep=None, out=None):
+    w = (out or sys.stdout).write
     w(f"bulkflow-theory: {m.name or 'material'}\n")
     w(f"  hopper : theta = {h.theta_deg:g} deg, H = {h.height:g} m above the apex (R = {est['R']:.3f} m along the wall)\n")
     w(f"  material: rho = {m.rho:g} kg/m3, phi = {m.phi_deg:g} deg, phi_w = {m.phi_w_deg:g} deg, "
@@ -213,8 +213,8 @@ def table_6_3(height=EL_HEIGHT, readings=DEFAULT_READINGS):
     return rows
 
 
-def print_table_6_3(rows, readings, out=sys.stdout):
-    w = out.write
+def print_table_6_3(rows, readings, out=None):
+    w = (out or sys.stdout).write
     w("Thesis Table 6.3 (theory columns) against bulkflow.theory, Eckhoff & Leversen powders.\n")
     w(f"Fill height {rows[0]['height']:g} m above the apex (not reported by E&L; assumed). Readings: "
       + ", ".join(f"{k} = {v}" for k, v in readings.items()) + ".\n")

@@ -264,9 +264,9 @@ def arching_solution(theta_deg, phi_deg, delta_deg, beta_arch_deg, beta_cons_deg
 
 
 def critical_radius(sol, n_grid: int = 4000) -> float:
-    """r*: the first root of σ̄₂(r) = 0 on (0, R] (hopper_theory.md §d.5).
+    """r*: the first root of σ̄₂(r) = 0 on (0, R) (hopper_theory.md §d.5).
 
-    Outlets at wall distance r_o < r* arch (no flow). Returns inf if σ̄₂ < 0 on all of (0, R]
+    Outlets at wall distance r_o < r* arch (no flow). Returns inf if σ̄₂ < 0 on all of (0, R)
     (an arch is stable at any outlet below the surface), 0 if σ̄₂(0+) ≥ 0 (no cohesion).
     Grid scan (geometric near the apex + uniform) then brentq to 1e-12 R.
     """
@@ -275,6 +275,9 @@ def critical_radius(sol, n_grid: int = 4000) -> float:
         return 0.0
     r = np.unique(np.concatenate([R * np.geomspace(1e-9, 1.0, n_grid // 2),
                                   R * np.linspace(0.0, 1.0, n_grid // 2 + 1)[1:]]))
+    # the surface r = R itself is excluded: there σ̄₂ = σ_R = 0 by the boundary condition, which
+    # is not an arch failure (σ̄₂ reaching 0 only at R means stable at every outlet below)
+    r = r[r < R * (1.0 - 1e-9)]
     s = sol(r)
     pos = np.nonzero(s >= 0.0)[0]
     if pos.size == 0:

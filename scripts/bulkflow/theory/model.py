@@ -126,7 +126,7 @@ class Hopper:
 def _enstad_width_numeric(h: Hopper, m: Material, ba: float, bc: float, delta: float, g: float):
     """Enstad with a non-linear flow function: numerical ODE (eq. 6.6 before substitution)."""
     R = h.R
-    r = R * np.linspace(1e-4, 1.0, 2001)
+    r = R * np.linspace(1e-4, 1.0, 2001)[:-1]     # the surface (σ̄₂ = 0 by the BC) excluded
     s2 = enstad.sigma2_bar_numeric(r, h.theta_deg, m.phi_deg, delta, ba, bc, m.flow_function,
                                    m.rho, R, g=g)
     pos = np.nonzero(s2 >= 0.0)[0]
@@ -137,7 +137,7 @@ def _enstad_width_numeric(h: Hopper, m: Material, ba: float, bc: float, delta: f
         return 0.0, 0.0
     # linear interpolation on a fine grid (2000 intervals)
     rs = r[i - 1] - s2[i - 1] * (r[i] - r[i - 1]) / (s2[i] - s2[i - 1])
-    return h.width_at(rs), rs
+    return float(h.width_at(rs)), float(rs)
 
 
 def critical_width_estimates(hopper: Hopper, material: Material, *,
