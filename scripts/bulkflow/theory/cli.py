@@ -158,16 +158,18 @@ def print_estimates(h, m, est, ex, sweep=None, out=None):
     w(f"  delta_mod = {est['delta_mod_deg']:.2f} deg, omega_p = {est['omega_p_deg']:.2f} deg, "
       f"X = {est['X']:.3f}, X_b = {est['X_b']:.3f}, W = {est['W']:.3f}, Y = {est['Y']:.3f}\n\n")
     flows = est.get("flows")
-    head = f"  {'theory':24s} {'B_crit (cm)':>20s}  {'fc at arch (Pa)':>15s}  {'sigma1 (Pa)':>12s}"
+    head = f"  {'theory':24s} {'B_crit (cm)':>20s}  {'fc at arch (Pa)':>15s}  {'cons. sigma1 (Pa)':>17s}"
     if flows:
         head += f"  flows at B = {100 * h.outlet_width:.1f} cm?"
     w(head + "\n")
     for t in THEORIES:
         fc = est[f"fc_{t}"]
         s1 = est["sigma1_cons_enstad"] if t == "enstad" else est[f"sigma1_outlet_{t}"]
-        line = f"  {LABEL[t]:24s} {_cm(est[t]):>20s}  {fc:15.1f}  {s1:12.4g}"
+        line = f"  {LABEL[t]:24s} {_cm(est[t]):>20s}  {fc:15.1f}  {s1:17.4g}"
         if flows:
-            line += "  " + ("flow" if flows[t] else "NO FLOW")
+            line += "  " + ("flow" if flows[t] else "NO FLOW").ljust(len("flows at B = 00.0 cm?"))
+        if m.k == 0.0 and t != "enstad":
+            line += "  (sigma1 unused: k = 0)"
         w(line + "\n")
     w("\n  Jenike under every beta reading (cm): " +
       ", ".join(f"{k} {_cm(v)}" for k, v in est["jenike_by_beta"].items()) + "\n")
