@@ -149,3 +149,19 @@ def test_cli_module_runs_as_a_process():
 def test_cli_console_script_declared():
     text = (SCRIPTS / "pyproject.toml").read_text()
     assert 'bulkflow-theory = "bulkflow.theory.cli:main"' in text
+
+
+def test_enstad_outlet_arch_for_scene_generators():
+    from bulkflow.theory import enstad_outlet_arch
+    a = cases.case("A")
+    arch = enstad_outlet_arch(a.hopper(2.0, outlet_width=0.5), a.material())
+    assert arch["beta_deg"] == pytest.approx(24.54, abs=0.01)
+    assert arch["r_wall"] == pytest.approx(0.5)
+    t = math.radians(30)
+    # the arc passes through both outlet edges (±r sin θ, r cos θ)
+    assert math.hypot(0.5 * math.sin(t), 0.5 * math.cos(t) - arch["centre_height"]) == pytest.approx(arch["radius"])
+    assert arch["crown_height"] == pytest.approx(arch["centre_height"] + arch["radius"])
+    b = enstad_outlet_arch(cases.case("B").hopper(2.0), cases.case("B").material(), outlet_width=0.3)
+    assert b["centre_height"] == pytest.approx(0.0) and b["radius"] == pytest.approx(0.3)
+    with pytest.raises(ValueError):
+        enstad_outlet_arch(cases.case("B").hopper(2.0), cases.case("B").material())

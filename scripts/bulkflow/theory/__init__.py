@@ -11,10 +11,12 @@ One module per theory: :mod:`.mohr`, :mod:`.flow_function`, :mod:`.beverloo`, :m
 :mod:`.flow_mode`; the thesis cases in :mod:`.cases`; the CLI in :mod:`.cli`.
 """
 from .model import (CONSOLIDATION_ROUTES, DEFAULT_READINGS, Hopper, Material,
-                    critical_width_estimates)
+                    critical_width_estimates, enstad_outlet_arch)
+from .enstad import arch_centre
 from .mohr import c_from_fc, delta_mod_deg, fc_from_c
 from .flow_function import BilinearFlowFunction, LinearFlowFunction
 
-__all__ = ["Material", "Hopper", "critical_width_estimates", "CONSOLIDATION_ROUTES",
+__all__ = ["Material", "Hopper", "critical_width_estimates", "enstad_outlet_arch", "arch_centre",
+           "CONSOLIDATION_ROUTES",
            "DEFAULT_READINGS", "fc_from_c", "c_from_fc", "delta_mod_deg",
            "LinearFlowFunction", "BilinearFlowFunction"]

@@ -25,8 +25,8 @@ from . import enstad, jenike, mclean
 from .flow_function import BilinearFlowFunction, LinearFlowFunction
 from .mohr import c_from_fc, delta_mod_deg, fc_from_c, wall_angle_passive_deg
 
-__all__ = ["Material", "Hopper", "critical_width_estimates", "CONSOLIDATION_ROUTES",
-           "DEFAULT_READINGS"]
+__all__ = ["Material", "Hopper", "critical_width_estimates", "enstad_outlet_arch",
+           "CONSOLIDATION_ROUTES", "DEFAULT_READINGS"]
 
 G_STANDARD = 9.81
 CONSOLIDATION_ROUTES = ("first_term", "full", "radial", "at_enstad")
@@ -298,3 +298,22 @@ def critical_width_estimates(hopper: Hopper, material: Material, *,
         out["outlet_width"] = h.outlet_width
         out["flows"] = {key: bool(h.outlet_width > out[key]) for key in ("mclean", "jenike", "enstad")}
     return out
+
+
+def enstad_outlet_arch(hopper: Hopper, material: Material, outlet_width: float | None = None,
+                       enstad_beta: str = DEFAULT_READINGS["enstad_beta"]) -> dict:
+    """Enstad's arch over an outlet, for scene generators that put the outlet arc on it.
+
+    Returns {'beta_deg', 'r_wall' (wall distance of the outlet edges), 'centre_height' (of the arc
+    centre above the apex, on the axis), 'radius', 'crown_height' (above the apex)}; β is the
+    arch β of :func:`bulkflow.theory.enstad.enstad_beta` with δ = δ_mod. β = 0 (smooth walls)
+    gives the apex-centred arc of the thesis FEM.
+    """
+    B = hopper.outlet_width if outlet_width is None else outlet_width
+    if B is None:
+        raise ValueError("enstad_outlet_arch: no outlet width")
+    ba, _ = enstad.enstad_beta(hopper.theta_deg, material.delta_mod_deg, material.phi_w_deg, enstad_beta)
+    r = hopper.outlet_radius(B)
+    c, a = enstad.arch_centre(r, hopper.theta_deg, ba)
+    return {"beta_deg": ba, "r_wall": r, "centre_height": float(c), "radius": float(a),
+            "crown_height": float(c + a)}
