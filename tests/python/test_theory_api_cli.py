@@ -165,3 +165,11 @@ def test_enstad_outlet_arch_for_scene_generators():
     assert b["centre_height"] == pytest.approx(0.0) and b["radius"] == pytest.approx(0.3)
     with pytest.raises(ValueError):
         enstad_outlet_arch(cases.case("B").hopper(2.0), cases.case("B").material())
+
+
+def test_hopper_from_scene_matches_the_scene_generator_geometry():
+    from bulkflow.scenes.wedge_hopper import WedgeHopper
+    scene = WedgeHopper(theta=30.0, outlet_width=0.4, height=1.5)
+    h = Hopper.from_scene(30.0, 0.4, 1.5)
+    assert h.height == pytest.approx(scene.top_y)
+    assert h.outlet_radius() == pytest.approx(scene.outlet_radius)

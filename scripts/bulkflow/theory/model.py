@@ -103,6 +103,16 @@ class Hopper:
     outlet_width: float | None = None
     length: float | None = None
 
+    @classmethod
+    def from_scene(cls, theta_deg: float, outlet_width: float, height_above_outlet: float,
+                   length: float | None = None) -> "Hopper":
+        """The hopper of a `bulkflow.scenes.wedge_hopper.WedgeHopper` scene: that generator
+        measures its `height` from the outlet line y = B/(2 tan θ) to the free surface, so the
+        surface is B/(2 tan θ) + height above the apex (for both its arc and flat bottoms)."""
+        apex = 0.5 * outlet_width / math.tan(math.radians(theta_deg))
+        return cls(theta_deg=theta_deg, height=apex + height_above_outlet,
+                   outlet_width=outlet_width, length=length)
+
     @property
     def R(self) -> float:
         """Apex → free surface along the wall: H / cos θ."""
