@@ -47,8 +47,15 @@ contains
     real(dp), intent(in) :: r_old(nb, ndim, ndim)
     real(dp), intent(out) :: r_mid(nb, ndim, ndim), r_new(nb, ndim, ndim), f_new(nb, ndim, ndim)
     real(dp), intent(out) :: strain_inc_corot(nb, 2 * ndim), rel_spin(nb, 2 * ndim - 3)
-    real(dp) :: f_mid(nb, ndim, ndim)
+    real(dp), allocatable :: f_mid(:, :, :)
 
+    if (ndim == 2 .and. nen == 4) then
+       call corotational_increment_2d(nb, bmat_ref, xe_mid, xe_new, strain_inc, spin_inc, r_old, &
+            r_mid, r_new, f_new, strain_inc_corot, rel_spin)
+       return
+    end if
+    ! 3D: F_{n+½} is only needed here (allocated, not automatic: the 2D path needs no memory).
+    allocate(f_mid(nb, ndim, ndim))
     call deformation_gradient(nb, ndim, nen, bmat_ref, xe_mid, f_mid)
     call polar_rotation(nb, ndim, f_mid, r_mid)
     call deformation_gradient(nb, ndim, nen, bmat_ref, xe_new, f_new)
@@ -56,6 +63,100 @@ contains
     call to_corotational(nb, ndim, 2 * ndim, r_mid, strain_inc, strain_inc_corot)
     call relative_spin(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
   end subroutine corotational_increment
+
+  !> corotational_increment for CPE4R as one element loop on scalars: F_{n+½} and R_{n+½} never
+  !> leave registers, and each element's data is read once (before: six passes over the block
+  !> and a heap-allocated F_{n+½}). Every quantity is the same sum, in the same order, as in
+  !> deformation_gradient, polar_rotation, rotate_symmetric_2d and relative_spin, so the results
+  !> are the same to the bit.
+  pure subroutine corotational_increment_2d(nb, bmat_ref, xe_mid, xe_new, strain_inc, spin_inc, &
+                                            r_old, r_mid, r_new, f_new, strain_inc_corot, rel_spin)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: bmat_ref(nb, 2, 4)
+    real(dp), intent(in) :: xe_mid(nb, 2, 4), xe_new(nb, 2, 4)
+    real(dp), intent(in) :: strain_inc(nb, 4), spin_inc(nb, 1)
+    real(dp), intent(in) :: r_old(nb, 2, 2)
+    real(dp), intent(out) :: r_mid(nb, 2, 2), r_new(nb, 2, 2), f_new(nb, 2, 2)
+    real(dp), intent(out) :: strain_inc_corot(nb, 4), rel_spin(nb, 1)
+    real(dp) :: x2, x3, x4, y2, y3, y4, f11, f21, f12, f22, c, s, nrm
+    real(dp) :: q11, q12, q21, q22, a11, a22, a12, t11, t12, t21, t22, u12, u21
+    real(dp) :: n11, n12, n21, n22, d11, d22, d12, d21
+    integer :: e
+
+    ! ivdep: the dummies do not alias (Fortran); without it the compiler wanted more run-time
+    ! alias checks than its limit and left the loop scalar.
+    !GCC$ ivdep
+    do e = 1, nb
+       ! F_{n+½} and R_{n+½} (deformation_gradient, polar_rotation)
+       x2 = xe_mid(e, 1, 2) - xe_mid(e, 1, 1)
+       x3 = xe_mid(e, 1, 3) - xe_mid(e, 1, 1)
+       x4 = xe_mid(e, 1, 4) - xe_mid(e, 1, 1)
+       y2 = xe_mid(e, 2, 2) - xe_mid(e, 2, 1)
+       y3 = xe_mid(e, 2, 3) - xe_mid(e, 2, 1)
+       y4 = xe_mid(e, 2, 4) - xe_mid(e, 2, 1)
+       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
+       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
+       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
+       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       c = f11 + f22
+       s = f21 - f12
+       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
+       q11 = c / nrm
+       q21 = s / nrm
+       q12 = -s / nrm
+       q22 = c / nrm
+       r_mid(e, 1, 1) = q11
+       r_mid(e, 2, 1) = q21
+       r_mid(e, 1, 2) = q12
+       r_mid(e, 2, 2) = q22
+       ! F_{n+1} and R_{n+1}
+       x2 = xe_new(e, 1, 2) - xe_new(e, 1, 1)
+       x3 = xe_new(e, 1, 3) - xe_new(e, 1, 1)
+       x4 = xe_new(e, 1, 4) - xe_new(e, 1, 1)
+       y2 = xe_new(e, 2, 2) - xe_new(e, 2, 1)
+       y3 = xe_new(e, 2, 3) - xe_new(e, 2, 1)
+       y4 = xe_new(e, 2, 4) - xe_new(e, 2, 1)
+       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
+       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
+       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
+       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       f_new(e, 1, 1) = f11
+       f_new(e, 2, 1) = f21
+       f_new(e, 1, 2) = f12
+       f_new(e, 2, 2) = f22
+       c = f11 + f22
+       s = f21 - f12
+       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
+       n11 = c / nrm
+       n21 = s / nrm
+       n12 = -s / nrm
+       n22 = c / nrm
+       r_new(e, 1, 1) = n11
+       r_new(e, 2, 1) = n21
+       r_new(e, 1, 2) = n12
+       r_new(e, 2, 2) = n22
+       ! strainInc = R_{n+½}ᵀ Δε R_{n+½} (rotate_symmetric_2d with q = R_{n+½}ᵀ: q12 = R21, q21 = R12)
+       a11 = strain_inc(e, 1)
+       a22 = strain_inc(e, 2)
+       a12 = strain_inc(e, 4)
+       t11 = (0.0_dp + a11 * q11) + a12 * q21
+       t12 = (0.0_dp + a11 * q12) + a12 * q22
+       t21 = (0.0_dp + a12 * q11) + a22 * q21
+       t22 = (0.0_dp + a12 * q12) + a22 * q22
+       strain_inc_corot(e, 1) = (0.0_dp + q11 * t11) + q21 * t21
+       strain_inc_corot(e, 2) = (0.0_dp + q12 * t12) + q22 * t22
+       strain_inc_corot(e, 3) = strain_inc(e, 3)
+       u12 = (0.0_dp + q11 * t12) + q21 * t22
+       u21 = (0.0_dp + q12 * t11) + q22 * t21
+       strain_inc_corot(e, 4) = 0.5_dp * (u12 + u21)
+       ! relSpinInc (relative_spin): ΔR = R_{n+1} R_nᵀ
+       d11 = (0.0_dp + n11 * r_old(e, 1, 1)) + n12 * r_old(e, 1, 2)
+       d22 = (0.0_dp + n21 * r_old(e, 2, 1)) + n22 * r_old(e, 2, 2)
+       d12 = (0.0_dp + n11 * r_old(e, 2, 1)) + n12 * r_old(e, 2, 2)
+       d21 = (0.0_dp + n21 * r_old(e, 1, 1)) + n22 * r_old(e, 1, 2)
+       rel_spin(e, 1) = spin_inc(e, 1) - 2.0_dp * (d21 - d12) / (2.0_dp + d11 + d22)
+    end do
+  end subroutine corotational_increment_2d
 
   !> Mean deformation gradient F = Σ_I x_I ⊗ B0_I of a block, B0 the mean gradient of the
   !> reference configuration (fem_cpe4r/fem_c3d8r geometry on x0). Exact for linear fields.
