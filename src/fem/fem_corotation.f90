@@ -28,6 +28,8 @@ module fem_corotation
   !> iterate is then orthogonal to ~1e-16 after the extra final step), or after max_newton.
   real(dp), parameter :: newton_tolerance = 1.0e-10_dp
   integer, parameter :: max_newton = 60
+  !> Elements per chunk of the 3D polar decomposition (polar_rotation_3d).
+  integer, parameter :: polar_chunk = 32
 
 contains
 
@@ -235,65 +237,94 @@ contains
     integer, intent(in) :: nb
     real(dp), intent(in) :: f(nb, 3, 3)
     real(dp), intent(out) :: r(nb, 3, 3)
-    real(dp) :: cof(nb, 3, 3), det(nb), gam(nb), xnorm2(nb), cnorm2(nb), change(nb)
-    real(dp) :: xnew
-    integer :: it, i, j, e
+    integer :: e0
+
+    ! Chunks of fixed size: the work arrays live on the stack (block-sized automatic arrays
+    ! are heap-allocated by gfortran, seven per call here), stay in L1, and the iterations stop
+    ! when the chunk has converged instead of the whole block. Each element's iterates depend
+    ! on that element alone, so the result does not depend on the chunking.
+    do e0 = 1, nb, polar_chunk
+       call polar_rotation_3d_chunk(nb, e0, min(polar_chunk, nb - e0 + 1), f, r)
+    end do
+  end subroutine polar_rotation_3d
+
+  !> polar_rotation_3d on the n elements e0..e0+n-1 of the block, with the operations of the
+  !> former whole-block form in the same order (bitwise the same R). Each step is a loop over
+  !> the chunk that vectorises.
+  pure subroutine polar_rotation_3d_chunk(nb, e0, n, f, r)
+    integer, intent(in) :: nb, e0, n
+    real(dp), intent(in) :: f(nb, 3, 3)
+    real(dp), intent(inout) :: r(nb, 3, 3)
+    real(dp) :: x(polar_chunk, 3, 3), cof(polar_chunk, 3, 3), det(polar_chunk), gam(polar_chunk)
+    real(dp) :: change(polar_chunk)
+    real(dp) :: xnew, xnorm2, cnorm2, d
+    integer :: it, i, j, k
     ! Per element: 0 scaled iterations, 1 the final unscaled step, 2 converged (frozen). The
     ! stopping test is each element's own, so an element's R does not depend on which other
     ! elements share its block (and results do not depend on the number of MPI ranks).
-    integer :: stage(nb)
+    integer :: stage(polar_chunk)
 
-    r = f
-    stage = 0
-    do it = 1, max_newton
-       call cofactor(nb, r, cof, det)
-       ! Guard against an exactly singular (collapsed) element: no division by zero.
-       det = sign(max(abs(det), tiny(1.0_dp)), det)
-       xnorm2 = 0.0_dp
-       cnorm2 = 0.0_dp
-       do j = 1, 3
-          do i = 1, 3
-             xnorm2 = xnorm2 + r(:, i, j)**2
-             cnorm2 = cnorm2 + cof(:, i, j)**2
-          end do
+    do j = 1, 3
+       do i = 1, 3
+          x(1:n, i, j) = f(e0:e0 + n - 1, i, j)
        end do
-       ! γ = (‖X⁻¹‖_F / ‖X‖_F)^½ with ‖X⁻¹‖_F = ‖cof X‖_F / |det X|; 1 for the final step.
-       gam = merge(sqrt(sqrt(cnorm2 / max(xnorm2, tiny(1.0_dp))) / abs(det)), 1.0_dp, stage == 0)
-       change = 0.0_dp
+    end do
+    stage(1:n) = 0
+    do it = 1, max_newton
+       do k = 1, n
+          ! cofactor matrix (cof X)_ij = ∂det X/∂X_ij and det X
+          cof(k, 1, 1) = x(k, 2, 2) * x(k, 3, 3) - x(k, 2, 3) * x(k, 3, 2)
+          cof(k, 1, 2) = x(k, 2, 3) * x(k, 3, 1) - x(k, 2, 1) * x(k, 3, 3)
+          cof(k, 1, 3) = x(k, 2, 1) * x(k, 3, 2) - x(k, 2, 2) * x(k, 3, 1)
+          cof(k, 2, 1) = x(k, 1, 3) * x(k, 3, 2) - x(k, 1, 2) * x(k, 3, 3)
+          cof(k, 2, 2) = x(k, 1, 1) * x(k, 3, 3) - x(k, 1, 3) * x(k, 3, 1)
+          cof(k, 2, 3) = x(k, 1, 2) * x(k, 3, 1) - x(k, 1, 1) * x(k, 3, 2)
+          cof(k, 3, 1) = x(k, 1, 2) * x(k, 2, 3) - x(k, 1, 3) * x(k, 2, 2)
+          cof(k, 3, 2) = x(k, 1, 3) * x(k, 2, 1) - x(k, 1, 1) * x(k, 2, 3)
+          cof(k, 3, 3) = x(k, 1, 1) * x(k, 2, 2) - x(k, 1, 2) * x(k, 2, 1)
+          d = x(k, 1, 1) * cof(k, 1, 1) + x(k, 1, 2) * cof(k, 1, 2) + x(k, 1, 3) * cof(k, 1, 3)
+          ! Guard against an exactly singular (collapsed) element: no division by zero.
+          d = sign(max(abs(d), tiny(1.0_dp)), d)
+          det(k) = d
+          ! Frobenius norms, column by column
+          xnorm2 = ((((((((0.0_dp + x(k, 1, 1)**2) + x(k, 2, 1)**2) + x(k, 3, 1)**2) + x(k, 1, 2)**2) &
+               + x(k, 2, 2)**2) + x(k, 3, 2)**2) + x(k, 1, 3)**2) + x(k, 2, 3)**2) + x(k, 3, 3)**2
+          cnorm2 = ((((((((0.0_dp + cof(k, 1, 1)**2) + cof(k, 2, 1)**2) + cof(k, 3, 1)**2) &
+               + cof(k, 1, 2)**2) + cof(k, 2, 2)**2) + cof(k, 3, 2)**2) + cof(k, 1, 3)**2) &
+               + cof(k, 2, 3)**2) + cof(k, 3, 3)**2
+          ! γ = (‖X⁻¹‖_F / ‖X‖_F)^½ with ‖X⁻¹‖_F = ‖cof X‖_F / |det X|
+          gam(k) = sqrt(sqrt(cnorm2 / max(xnorm2, tiny(1.0_dp))) / abs(d))
+       end do
+       ! 1 for the final step. (Its own loop: in the one above the compiler moved the square
+       ! roots under a branch on the stage and could no longer vectorise.)
+       do k = 1, n
+          gam(k) = merge(gam(k), 1.0_dp, stage(k) == 0)
+       end do
+       change(1:n) = 0.0_dp
        do j = 1, 3
           do i = 1, 3
-             do e = 1, nb
+             do k = 1, n
                 ! X⁻ᵀ = cof(X) / det X
-                xnew = 0.5_dp * (gam(e) * r(e, i, j) + cof(e, i, j) / (gam(e) * det(e)))
-                change(e) = change(e) + (xnew - r(e, i, j))**2
-                r(e, i, j) = merge(xnew, r(e, i, j), stage(e) < 2)
+                xnew = 0.5_dp * (gam(k) * x(k, i, j) + cof(k, i, j) / (gam(k) * det(k)))
+                change(k) = change(k) + (xnew - x(k, i, j))**2
+                x(k, i, j) = merge(xnew, x(k, i, j), stage(k) < 2)
              end do
           end do
        end do
        ! Near convergence the scaling is switched off for one last plain Newton step, which
        ! restores full quadratic convergence to an orthogonal matrix.
-       stage = merge(stage + 1, stage, stage == 1 .or. (stage == 0 .and. change <= newton_tolerance**2))
-       if (all(stage == 2)) exit
+       do k = 1, n
+          stage(k) = merge(stage(k) + 1, stage(k), stage(k) == 1 .or. &
+               (stage(k) == 0 .and. change(k) <= newton_tolerance**2))
+       end do
+       if (all(stage(1:n) == 2)) exit
     end do
-  end subroutine polar_rotation_3d
-
-  !> Cofactor matrix (cof X)_ij = ∂det X/∂X_ij and det X of a block of 3×3 matrices.
-  pure subroutine cofactor(nb, x, cof, det)
-    integer, intent(in) :: nb
-    real(dp), intent(in) :: x(nb, 3, 3)
-    real(dp), intent(out) :: cof(nb, 3, 3), det(nb)
-
-    cof(:, 1, 1) = x(:, 2, 2) * x(:, 3, 3) - x(:, 2, 3) * x(:, 3, 2)
-    cof(:, 1, 2) = x(:, 2, 3) * x(:, 3, 1) - x(:, 2, 1) * x(:, 3, 3)
-    cof(:, 1, 3) = x(:, 2, 1) * x(:, 3, 2) - x(:, 2, 2) * x(:, 3, 1)
-    cof(:, 2, 1) = x(:, 1, 3) * x(:, 3, 2) - x(:, 1, 2) * x(:, 3, 3)
-    cof(:, 2, 2) = x(:, 1, 1) * x(:, 3, 3) - x(:, 1, 3) * x(:, 3, 1)
-    cof(:, 2, 3) = x(:, 1, 2) * x(:, 3, 1) - x(:, 1, 1) * x(:, 3, 2)
-    cof(:, 3, 1) = x(:, 1, 2) * x(:, 2, 3) - x(:, 1, 3) * x(:, 2, 2)
-    cof(:, 3, 2) = x(:, 1, 3) * x(:, 2, 1) - x(:, 1, 1) * x(:, 2, 3)
-    cof(:, 3, 3) = x(:, 1, 1) * x(:, 2, 2) - x(:, 1, 2) * x(:, 2, 1)
-    det = x(:, 1, 1) * cof(:, 1, 1) + x(:, 1, 2) * cof(:, 1, 2) + x(:, 1, 3) * cof(:, 1, 3)
-  end subroutine cofactor
+    do j = 1, 3
+       do i = 1, 3
+          r(e0:e0 + n - 1, i, j) = x(1:n, i, j)
+       end do
+    end do
+  end subroutine polar_rotation_3d_chunk
 
   !> R = I for every element (initial rotation state when the initial configuration is the
   !> reference one).
