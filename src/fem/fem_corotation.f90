@@ -189,6 +189,20 @@ contains
        end do
        return
     end if
+    if (ndim == 3 .and. nen == 8) then
+       ! C3D8R: each F_ij in one pass, the sum over the nodes written out in the order of the
+       ! general loop below (bitwise the same F), instead of seven read-modify-write passes.
+       f(:, 1, 1) = ((((((0.0_dp + (xe(:, 1, 2) - xe(:, 1, 1)) * bmat_ref(:, 1, 2)) + (xe(:, 1, 3) - xe(:, 1, 1)) * bmat_ref(:, 1, 3)) + (xe(:, 1, 4) - xe(:, 1, 1)) * bmat_ref(:, 1, 4)) + (xe(:, 1, 5) - xe(:, 1, 1)) * bmat_ref(:, 1, 5)) + (xe(:, 1, 6) - xe(:, 1, 1)) * bmat_ref(:, 1, 6)) + (xe(:, 1, 7) - xe(:, 1, 1)) * bmat_ref(:, 1, 7)) + (xe(:, 1, 8) - xe(:, 1, 1)) * bmat_ref(:, 1, 8)
+       f(:, 2, 1) = ((((((0.0_dp + (xe(:, 2, 2) - xe(:, 2, 1)) * bmat_ref(:, 1, 2)) + (xe(:, 2, 3) - xe(:, 2, 1)) * bmat_ref(:, 1, 3)) + (xe(:, 2, 4) - xe(:, 2, 1)) * bmat_ref(:, 1, 4)) + (xe(:, 2, 5) - xe(:, 2, 1)) * bmat_ref(:, 1, 5)) + (xe(:, 2, 6) - xe(:, 2, 1)) * bmat_ref(:, 1, 6)) + (xe(:, 2, 7) - xe(:, 2, 1)) * bmat_ref(:, 1, 7)) + (xe(:, 2, 8) - xe(:, 2, 1)) * bmat_ref(:, 1, 8)
+       f(:, 3, 1) = ((((((0.0_dp + (xe(:, 3, 2) - xe(:, 3, 1)) * bmat_ref(:, 1, 2)) + (xe(:, 3, 3) - xe(:, 3, 1)) * bmat_ref(:, 1, 3)) + (xe(:, 3, 4) - xe(:, 3, 1)) * bmat_ref(:, 1, 4)) + (xe(:, 3, 5) - xe(:, 3, 1)) * bmat_ref(:, 1, 5)) + (xe(:, 3, 6) - xe(:, 3, 1)) * bmat_ref(:, 1, 6)) + (xe(:, 3, 7) - xe(:, 3, 1)) * bmat_ref(:, 1, 7)) + (xe(:, 3, 8) - xe(:, 3, 1)) * bmat_ref(:, 1, 8)
+       f(:, 1, 2) = ((((((0.0_dp + (xe(:, 1, 2) - xe(:, 1, 1)) * bmat_ref(:, 2, 2)) + (xe(:, 1, 3) - xe(:, 1, 1)) * bmat_ref(:, 2, 3)) + (xe(:, 1, 4) - xe(:, 1, 1)) * bmat_ref(:, 2, 4)) + (xe(:, 1, 5) - xe(:, 1, 1)) * bmat_ref(:, 2, 5)) + (xe(:, 1, 6) - xe(:, 1, 1)) * bmat_ref(:, 2, 6)) + (xe(:, 1, 7) - xe(:, 1, 1)) * bmat_ref(:, 2, 7)) + (xe(:, 1, 8) - xe(:, 1, 1)) * bmat_ref(:, 2, 8)
+       f(:, 2, 2) = ((((((0.0_dp + (xe(:, 2, 2) - xe(:, 2, 1)) * bmat_ref(:, 2, 2)) + (xe(:, 2, 3) - xe(:, 2, 1)) * bmat_ref(:, 2, 3)) + (xe(:, 2, 4) - xe(:, 2, 1)) * bmat_ref(:, 2, 4)) + (xe(:, 2, 5) - xe(:, 2, 1)) * bmat_ref(:, 2, 5)) + (xe(:, 2, 6) - xe(:, 2, 1)) * bmat_ref(:, 2, 6)) + (xe(:, 2, 7) - xe(:, 2, 1)) * bmat_ref(:, 2, 7)) + (xe(:, 2, 8) - xe(:, 2, 1)) * bmat_ref(:, 2, 8)
+       f(:, 3, 2) = ((((((0.0_dp + (xe(:, 3, 2) - xe(:, 3, 1)) * bmat_ref(:, 2, 2)) + (xe(:, 3, 3) - xe(:, 3, 1)) * bmat_ref(:, 2, 3)) + (xe(:, 3, 4) - xe(:, 3, 1)) * bmat_ref(:, 2, 4)) + (xe(:, 3, 5) - xe(:, 3, 1)) * bmat_ref(:, 2, 5)) + (xe(:, 3, 6) - xe(:, 3, 1)) * bmat_ref(:, 2, 6)) + (xe(:, 3, 7) - xe(:, 3, 1)) * bmat_ref(:, 2, 7)) + (xe(:, 3, 8) - xe(:, 3, 1)) * bmat_ref(:, 2, 8)
+       f(:, 1, 3) = ((((((0.0_dp + (xe(:, 1, 2) - xe(:, 1, 1)) * bmat_ref(:, 3, 2)) + (xe(:, 1, 3) - xe(:, 1, 1)) * bmat_ref(:, 3, 3)) + (xe(:, 1, 4) - xe(:, 1, 1)) * bmat_ref(:, 3, 4)) + (xe(:, 1, 5) - xe(:, 1, 1)) * bmat_ref(:, 3, 5)) + (xe(:, 1, 6) - xe(:, 1, 1)) * bmat_ref(:, 3, 6)) + (xe(:, 1, 7) - xe(:, 1, 1)) * bmat_ref(:, 3, 7)) + (xe(:, 1, 8) - xe(:, 1, 1)) * bmat_ref(:, 3, 8)
+       f(:, 2, 3) = ((((((0.0_dp + (xe(:, 2, 2) - xe(:, 2, 1)) * bmat_ref(:, 3, 2)) + (xe(:, 2, 3) - xe(:, 2, 1)) * bmat_ref(:, 3, 3)) + (xe(:, 2, 4) - xe(:, 2, 1)) * bmat_ref(:, 3, 4)) + (xe(:, 2, 5) - xe(:, 2, 1)) * bmat_ref(:, 3, 5)) + (xe(:, 2, 6) - xe(:, 2, 1)) * bmat_ref(:, 3, 6)) + (xe(:, 2, 7) - xe(:, 2, 1)) * bmat_ref(:, 3, 7)) + (xe(:, 2, 8) - xe(:, 2, 1)) * bmat_ref(:, 3, 8)
+       f(:, 3, 3) = ((((((0.0_dp + (xe(:, 3, 2) - xe(:, 3, 1)) * bmat_ref(:, 3, 2)) + (xe(:, 3, 3) - xe(:, 3, 1)) * bmat_ref(:, 3, 3)) + (xe(:, 3, 4) - xe(:, 3, 1)) * bmat_ref(:, 3, 4)) + (xe(:, 3, 5) - xe(:, 3, 1)) * bmat_ref(:, 3, 5)) + (xe(:, 3, 6) - xe(:, 3, 1)) * bmat_ref(:, 3, 6)) + (xe(:, 3, 7) - xe(:, 3, 1)) * bmat_ref(:, 3, 7)) + (xe(:, 3, 8) - xe(:, 3, 1)) * bmat_ref(:, 3, 8)
+       return
+    end if
     f = 0.0_dp
     do n = 2, nen
        do j = 1, ndim
