@@ -11,7 +11,7 @@ module driver_elements
   use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
        effect_bulk_viscosity, effect_user_field
   use driver_vumat_call, only: vumat_work_t, call_material, vumat_work_init
-  use fem_cpe4r, only: cpe4r_kinematics, cpe4r_internal_force, cpe4r_hourglass
+  use fem_cpe4r, only: cpe4r_kinematics, cpe4r_internal_force, cpe4r_hourglass_update
   use fem_c3d8r, only: c3d8r_kinematics, c3d8r_internal_force, c3d8r_hourglass
   use fem_corotation, only: corotational_increment, deformation_gradient, to_global, vumat_defgrad, &
        vumat_stretch
@@ -29,6 +29,7 @@ module driver_elements
      real(dp), allocatable :: bmat_mid(:, :, :), bmat_new(:, :, :), fe(:, :, :), fe_hg(:, :, :)
      real(dp), allocatable :: volume_mid(:), volume_new(:), char_length(:), density(:), modulus(:)
      real(dp), allocatable :: volume_abs(:)           !< |volume_mid| (no temporary per call)
+     real(dp), allocatable :: e_hg_kernel(:)          !< the hourglass kernel's own ΔE (not booked)
      real(dp), allocatable :: wave_speed(:), sigma_bv(:), xi(:), e_bv(:), e_hg(:), dt_el(:)
      real(dp), allocatable :: strain_inc(:, :), spin_inc(:, :), strain_corot(:, :), rel_spin(:, :)
      real(dp), allocatable :: r_mid(:, :, :), r_new(:, :, :), f_old(:, :, :), f_new(:, :, :)
@@ -61,7 +62,7 @@ contains
     allocate(w%fe(nmax, ndim, nen), w%fe_hg(nmax, ndim, nen))
     allocate(w%volume_mid(nmax), w%volume_new(nmax), w%char_length(nmax), w%density(nmax))
     allocate(w%modulus(nmax), w%wave_speed(nmax), w%sigma_bv(nmax), w%xi(nmax), w%e_bv(nmax))
-    allocate(w%e_hg(nmax), w%dt_el(nmax), w%reason(nmax), w%volume_abs(nmax))
+    allocate(w%e_hg(nmax), w%dt_el(nmax), w%reason(nmax), w%volume_abs(nmax), w%e_hg_kernel(nmax))
     allocate(w%strain_inc(nmax, ncomp), w%spin_inc(nmax, nshr), w%strain_corot(nmax, ncomp))
     allocate(w%rel_spin(nmax, nshr), w%stress_force(nmax, ncomp))
     allocate(w%r_mid(nmax, ndim, ndim), w%r_new(nmax, ndim, ndim), w%f_old(nmax, ndim, ndim))
@@ -136,8 +137,13 @@ contains
        iw = work_set(ws, solver%blocks(ib)%count)
        associate (blk => solver%blocks(ib), w => ws%sets(iw))
          nb = blk%count
-         call gather_block(nb, nd, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
-              solver%u, solver%du, w%xe_old, w%du, w%xe_mid, w%xe_new)
+         if (nd == 2) then
+            call gather_block_2d(nb, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
+                 solver%u, solver%du, w%xe_old, w%du, w%xe_mid, w%xe_new)
+         else
+            call gather_block(nb, nd, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
+                 solver%u, solver%du, w%xe_old, w%du, w%xe_mid, w%xe_new)
+         end if
          call block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
          do e = 1, nb
             if (w%dt_el(e) < dt_min) then
@@ -162,10 +168,12 @@ contains
     integer :: e, i, a, k
     real(dp) :: xo, d
 
+    ! The node index once per (node, element), all components from it (they are adjacent in
+    ! the nodal arrays). gather_block_2d: the same with a literal component count.
     do a = 1, ne
-       do i = 1, nd
-          do e = 1, nb
-             k = conn(a, e)
+       do e = 1, nb
+          k = conn(a, e)
+          do i = 1, nd
              xo = x0(i, k) + u(i, k)
              d = du_nodes(i, k)
              xe_old(e, i, a) = xo
@@ -176,6 +184,34 @@ contains
        end do
     end do
   end subroutine gather_block
+
+  !> gather_block for two components (CPE4R).
+  subroutine gather_block_2d(nb, ne, conn, x0, u, du_nodes, xe_old, du, xe_mid, xe_new)
+    integer, intent(in) :: nb, ne
+    integer, intent(in) :: conn(ne, nb)
+    real(dp), intent(in) :: x0(2, *), u(2, *), du_nodes(2, *)
+    real(dp), intent(out) :: xe_old(nb, 2, ne), du(nb, 2, ne), xe_mid(nb, 2, ne), xe_new(nb, 2, ne)
+    integer :: e, a, k
+    real(dp) :: xo1, xo2, d1, d2
+
+    do a = 1, ne
+       do e = 1, nb
+          k = conn(a, e)
+          xo1 = x0(1, k) + u(1, k)
+          xo2 = x0(2, k) + u(2, k)
+          d1 = du_nodes(1, k)
+          d2 = du_nodes(2, k)
+          xe_old(e, 1, a) = xo1
+          xe_old(e, 2, a) = xo2
+          du(e, 1, a) = d1
+          du(e, 2, a) = d2
+          xe_mid(e, 1, a) = xo1 + 0.5_dp * d1
+          xe_mid(e, 2, a) = xo2 + 0.5_dp * d2
+          xe_new(e, 1, a) = xo1 + d1
+          xe_new(e, 2, a) = xo2 + d2
+       end do
+    end do
+  end subroutine gather_block_2d
 
   subroutine block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
     type(model_t), intent(in) :: m
@@ -285,7 +321,6 @@ contains
     if (effects%active(effect_hourglass)) then
        call effects%stop(effect_elements)
        call effects%start(effect_hourglass)
-       w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)
        ! The hourglass form and coefficient of this block's section (a block has one section).
        ! Before, every element used the first section's, whatever its own *SECTION CONTROLS said.
        hourglass_kind = m%sections(blk%section)%hourglass
@@ -293,30 +328,34 @@ contains
        if (hourglass_coefficient <= 0) hourglass_coefficient = merge(default_hourglass_viscous_coefficient, &
             default_hourglass_stiffness_coefficient, hourglass_kind == hourglass_viscous)
        w%modulus(1:nb) = blk%wave_modulus
-       if (plane) then
-          call cpe4r_hourglass(nb, blk%thickness, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), &
-               w%bmat_mid(1:nb, :, :), w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), &
-               hourglass_kind, hourglass_coefficient, w%r_mid(1:nb, :, :), blk%rotation, blk%hourglass, &
-               w%fe(1:nb, :, :), w%e_hg(1:nb))
-       else
-          call c3d8r_hourglass(nb, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), &
-               w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), hourglass_kind, &
-               hourglass_coefficient, w%r_mid(1:nb, :, :), blk%rotation, blk%hourglass, w%fe(1:nb, :, :), &
-               w%e_hg(1:nb))
-       end if
        ! ALLAE as the work of the hourglass forces with the trapezoidal rule, ½ (f_n + f_{n+1})·Δu,
        ! as the balance charges it (the kernels' C q²/Δt of the viscous form pairs the force of
        ! t_{n+1} with this increment alone; where the rates change fast — a block released from
        ! its initial stress — that lag put 1 % of the energies into ETOTAL). For the stiffness form
-       ! the two agree up to the rotation of the increment.
-       w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :) - w%fe_hg(1:nb, :, :)
-       w%e_hg(1:nb) = 0
-       do a = 1, ne
-          do i = 1, nd
-             w%e_hg(1:nb) = w%e_hg(1:nb) + 0.5_dp * (blk%force_hg(:, i, a) + w%fe_hg(1:nb, i, a)) * w%du(1:nb, i, a)
+       ! the two agree up to the rotation of the increment. f_{n+1} is the change of fe the
+       ! hourglass forces make; blk%force_hg keeps it for the next increment.
+       if (plane) then
+          ! One fused kernel: forces, force change and work in one pass over the block.
+          call cpe4r_hourglass_update(nb, blk%thickness, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), &
+               w%bmat_mid(1:nb, :, :), w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), &
+               hourglass_kind, hourglass_coefficient, w%r_mid(1:nb, :, :), blk%rotation, blk%hourglass, &
+               w%fe(1:nb, :, :), blk%force_hg, w%e_hg_kernel(1:nb), w%e_hg(1:nb))
+       else
+          w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)
+          call c3d8r_hourglass(nb, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), &
+               w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), hourglass_kind, &
+               hourglass_coefficient, w%r_mid(1:nb, :, :), blk%rotation, blk%hourglass, w%fe(1:nb, :, :), &
+               w%e_hg(1:nb))
+          w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :) - w%fe_hg(1:nb, :, :)
+          w%e_hg(1:nb) = 0
+          do a = 1, ne
+             do i = 1, nd
+                w%e_hg(1:nb) = w%e_hg(1:nb) + 0.5_dp * (blk%force_hg(:, i, a) + w%fe_hg(1:nb, i, a)) &
+                     * w%du(1:nb, i, a)
+             end do
           end do
-       end do
-       blk%force_hg = w%fe_hg(1:nb, :, :)
+          blk%force_hg = w%fe_hg(1:nb, :, :)
+       end if
        solver%e_artificial = solver%e_artificial + sum(w%e_hg(1:nb))
        call effects%stop(effect_hourglass)
        call effects%start(effect_elements)

@@ -137,6 +137,8 @@ contains
       else
          allocate(loads%contact(0))
       end if
+      ! Contact forces are zero except at this step's slave nodes (apply_contact resets only those).
+      solver%f_contact = 0
     end associate
   end subroutine prepare_step
 
@@ -263,19 +265,33 @@ contains
     type(solver_t), intent(inout) :: solver
     real(dp), intent(in) :: dt, dt_avg
     real(dp), intent(out) :: friction_work
-    integer :: j, pass, npass, i, nd
+    integer :: j, pass, npass, i, nd, k
     real(dp), allocatable :: x(:, :), force(:, :)
     logical, allocatable :: touching(:)
     real(dp) :: work, scale
 
     nd = solver%ndim
     friction_work = 0
-    solver%f_contact = 0
     solver%wall_force = 0
     if (size(loads%contact) == 0) return
     scale = dt / dt_avg
+    ! x_n = x0 + u, and the reset of f_contact, at the slave nodes only: the kernel reads no other
+    ! node, and f_contact is zero elsewhere (prepare_step). Two passes over every node were most
+    ! of the time of this routine.
     allocate(x(nd, solver%n_nodes))
-    x = solver%x0 + solver%u
+    do j = 1, size(loads%contact)
+       associate (c => loads%contact(j))
+         do i = 1, size(c%owned)
+            k = c%owned(i)
+            x(:, k) = solver%x0(:, k) + solver%u(:, k)
+            solver%f_contact(:, k) = 0
+         end do
+         do i = 1, size(c%others)
+            k = c%others(i)
+            x(:, k) = solver%x0(:, k) + solver%u(:, k)
+         end do
+       end associate
+    end do
     npass = merge(2, 1, size(loads%contact) > 1)
     do pass = 1, npass
        do j = 1, size(loads%contact)

@@ -163,6 +163,7 @@ contains
     real(dp), intent(out) :: dt_min
     real(dp) :: dt, dt_avg, t_mid, t_new, work
     integer :: i, dt_elem
+    logical :: gravity_varies
 
     associate (s => m%steps(istep))
       ! Time increment: the stable one (scaled), or the user's; never past the end of the step.
@@ -178,9 +179,8 @@ contains
 
       ! Velocities at mid-increment (the first increment of the run starts from v_0 with dt/2).
       dt_avg = merge(0.5_dp * dt, 0.5_dp * (solver%dt_prev + dt), solver%increment == 0)
-      solver%v_old = solver%v
-      solver%v = solver%v + dt_avg * solver%a
-      solver%v_free = solver%v
+      call update_velocities(solver%n_nodes * solver%ndim, dt_avg, solver%a, solver%v, solver%v_old, &
+           solver%v_free)
 
       if (effects%active(effect_boundary)) then
          call effects%start(effect_boundary)
@@ -197,11 +197,10 @@ contains
          call apply_prescribed_velocities(m, loads, solver, t_mid, t_new, dt)
          call effects%stop(effect_rigid_walls)
       end if
-      call constraint_work(solver, dt_avg, work)
+      ! Also forms du = Δt v_{n+½} (the same pass over the nodes).
+      call constraint_work(solver, dt, dt_avg, work)
 
-      solver%du = dt * solver%v
       call element_phase(m, solver, effects, ew, dt, s%bulk_linear, s%bulk_quadratic, dt_min, dt_elem)
-      solver%u = solver%u + solver%du
       do i = 1, size(solver%rigid)
          solver%rigid(i)%u = solver%rigid(i)%u + dt * solver%rigid(i)%v
       end do
@@ -209,20 +208,20 @@ contains
       call effects%start(effect_assembly)
       call assemble_element_vectors(solver%part, solver%ndim, solver%fe, solver%f_int)
       call effects%stop(effect_assembly)
-      solver%f_ext_old = solver%f_ext
-      if (effects%active(effect_gravity)) then
+      ! Gravity without an amplitude is the same at every time of the step: f_ext (set at the
+      ! step start, or read from the checkpoint) stays, and f_ext_old is f_ext. Recomputing it
+      ! gave the same numbers at the cost of two passes over the nodes. (Code that changes the
+      ! gravity loads within a step must call gravity_forces itself.)
+      gravity_varies = effects%active(effect_gravity) .and. gravity_has_amplitude(loads)
+      if (gravity_varies) then
+         solver%f_ext_old = solver%f_ext
          call effects%start(effect_gravity)
          call gravity_forces(m, loads, solver, t_new, solver%f_ext)
          call effects%stop(effect_gravity)
+         call finish_nodes(solver, solver%f_ext_old)
+      else
+         call finish_nodes(solver, solver%f_ext)
       end if
-      call update_accelerations(solver)
-
-      ! Work of gravity on this rank's owned nodes (trapezoidal rule over the increment).
-      do i = 1, solver%n_nodes
-         if (.not. solver%part%node_owned(i)) cycle
-         solver%e_external = solver%e_external + sum(0.5_dp * (solver%f_ext_old(:, i) + solver%f_ext(:, i)) &
-              * solver%du(:, i))
-      end do
 
       solver%step_time = t_new
       solver%total_time = solver%step_start + t_new
@@ -260,23 +259,124 @@ contains
   !> friction (the contact kernel's friction_work) separately, so it is added back here: ALLWK
   !> holds the wall's work and the landing losses (Abaqus books the latter as ALLPW, which we do
   !> not have). A fixed wall with steady sliding contributes nothing, as in Abaqus.
-  subroutine constraint_work(solver, dt_avg, friction_work)
+  !> The same pass over the nodes also forms du = Δt v_{n+½} for the element phase.
+  subroutine constraint_work(solver, dt, dt_avg, friction_work)
     type(solver_t), intent(inout) :: solver
-    real(dp), intent(in) :: dt_avg, friction_work
-    integer :: i
-    real(dp) :: work, ddt, impulse(solver%ndim), a(solver%ndim)
+    real(dp), intent(in) :: dt, dt_avg, friction_work
+    real(dp) :: work
 
     work = 0
-    ddt = 0.25_dp * (solver%dt_prev - solver%dt)
-    do i = 1, solver%n_nodes
-       if (.not. solver%part%node_owned(i) .or. solver%mass(i) <= 0) cycle
-       a = solver%a(:, i) - solver%reaction(:, i) / solver%mass(i)
-       impulse = solver%mass(i) * (solver%v(:, i) - solver%v_free(:, i)) + dt_avg * solver%reaction(:, i)
-       work = work + 0.5_dp * sum(impulse * (solver%v_old(:, i) + solver%v(:, i))) &
-            + ddt * (dt_avg * solver%mass(i) * sum(a**2) + sum(a * impulse))
-    end do
+    if (solver%ndim == 2) then
+       ! A literal component count: the compiler keeps the per-node sums in registers.
+       call constraint_work_nodes(2, solver%n_nodes, solver%part%node_owned, solver%mass, solver%a, &
+            solver%reaction, solver%v, solver%v_free, solver%v_old, solver%dt_prev, dt, dt_avg, &
+            solver%du, work)
+    else
+       call constraint_work_nodes(solver%ndim, solver%n_nodes, solver%part%node_owned, solver%mass, &
+            solver%a, solver%reaction, solver%v, solver%v_free, solver%v_old, solver%dt_prev, dt, &
+            dt_avg, solver%du, work)
+    end if
     solver%e_external = solver%e_external + work + friction_work
   end subroutine constraint_work
+
+  !> The node loop of constraint_work: work += Σ over owned nodes with mass, in node order; the
+  !> per-node sums over the components run from 0 in component order (as sum() did), so the
+  !> result is the same to the bit. du = dt v on every node.
+  pure subroutine constraint_work_nodes(nd, nn, owned, mass, a, reaction, v, v_free, v_old, &
+       dt_prev, dt, dt_avg, du, work)
+    integer, intent(in) :: nd, nn
+    logical, intent(in) :: owned(nn)
+    real(dp), intent(in) :: mass(nn), a(nd, nn), reaction(nd, nn), v(nd, nn), v_free(nd, nn)
+    real(dp), intent(in) :: v_old(nd, nn), dt_prev, dt, dt_avg
+    real(dp), intent(out) :: du(nd, nn)
+    real(dp), intent(inout) :: work
+    integer :: i, j
+    real(dp) :: ddt, aj, impulse, s_v, s_a2, s_ai
+
+    ddt = 0.25_dp * (dt_prev - dt)
+    do i = 1, nn
+       do j = 1, nd
+          du(j, i) = dt * v(j, i)
+       end do
+       if (.not. owned(i) .or. mass(i) <= 0) cycle
+       s_v = 0
+       s_a2 = 0
+       s_ai = 0
+       do j = 1, nd
+          aj = a(j, i) - reaction(j, i) / mass(i)
+          impulse = mass(i) * (v(j, i) - v_free(j, i)) + dt_avg * reaction(j, i)
+          s_v = s_v + impulse * (v_old(j, i) + v(j, i))
+          s_a2 = s_a2 + aj**2
+          s_ai = s_ai + aj * impulse
+       end do
+       work = work + 0.5_dp * s_v + ddt * (dt_avg * mass(i) * s_a2 + s_ai)
+    end do
+  end subroutine constraint_work_nodes
+
+  !> v_{n-1/2} kept, v_{n+1/2} = v_{n-1/2} + Δt_avg a_n, and the unconstrained copy v_free, in one
+  !> pass (n = ndim × nodes values).
+  pure subroutine update_velocities(n, dt_avg, a, v, v_old, v_free)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: dt_avg, a(n)
+    real(dp), intent(inout) :: v(n)
+    real(dp), intent(out) :: v_old(n), v_free(n)
+    integer :: k
+    real(dp) :: vk
+
+    do k = 1, n
+       vk = v(k)
+       v_old(k) = vk
+       vk = vk + dt_avg * a(k)
+       v(k) = vk
+       v_free(k) = vk
+    end do
+  end subroutine update_velocities
+
+  !> The node pass that closes an increment, after the assembly and gravity: u_{n+1} = u_n + du,
+  !> accelerations and reactions (update_accelerations), and the work of gravity on this rank's
+  !> owned nodes with the trapezoidal rule, ½ (f_ext,n + f_ext,n+1)·du, in node order.
+  !> f_ext_old: f_ext at t_n (solver%f_ext itself when it did not change).
+  subroutine finish_nodes(solver, f_ext_old)
+    type(solver_t), intent(inout) :: solver
+    real(dp), intent(in) :: f_ext_old(:, :)
+
+    if (solver%ndim == 2) then
+       ! A literal component count: the compiler keeps the per-node sums in registers.
+       call finish_nodes_kernel(2, solver%n_nodes, solver%part%node_owned, solver%fixed, solver%mass, &
+            solver%f_int, solver%f_ext, f_ext_old, solver%du, solver%u, solver%a, solver%reaction, &
+            solver%e_external)
+    else
+       call finish_nodes_kernel(solver%ndim, solver%n_nodes, solver%part%node_owned, solver%fixed, &
+            solver%mass, solver%f_int, solver%f_ext, f_ext_old, solver%du, solver%u, solver%a, &
+            solver%reaction, solver%e_external)
+    end if
+  end subroutine finish_nodes
+
+  !> finish_nodes on explicit-shape arrays (the compiler then keeps the loop tight; on the
+  !> solver's allocatable components it reloaded their descriptors at every store).
+  pure subroutine finish_nodes_kernel(nd, nn, owned, fixed, mass, f_int, f_ext, f_ext_old, du, u, a, &
+       reaction, e_external)
+    integer, intent(in) :: nd, nn
+    logical, intent(in) :: owned(nn), fixed(nd, nn)
+    real(dp), intent(in) :: mass(nn), f_int(nd, nn), f_ext(nd, nn), f_ext_old(nd, nn), du(nd, nn)
+    real(dp), intent(inout) :: u(nd, nn), e_external
+    real(dp), intent(out) :: a(nd, nn), reaction(nd, nn)
+    integer :: i, j
+    real(dp) :: w
+
+    do i = 1, nn
+       do j = 1, nd
+          u(j, i) = u(j, i) + du(j, i)
+          call dof_acceleration(fixed(j, i), mass(i), f_int(j, i), f_ext(j, i), a(j, i), reaction(j, i))
+       end do
+       if (.not. owned(i)) cycle
+       w = 0
+       do j = 1, nd
+          w = w + 0.5_dp * (f_ext_old(j, i) + f_ext(j, i)) * du(j, i)
+       end do
+       e_external = e_external + w
+    end do
+  end subroutine finish_nodes_kernel
 
   !> ½ Σ_e M_e V_e (M the P-wave modulus): the strain energy of the whole model at unit strain,
   !> equal to ½ Σ m c_d², the kinetic energy at the wave speed. Scale of "significant" energies.
@@ -299,21 +399,43 @@ contains
 
     do i = 1, solver%n_nodes
        do j = 1, solver%ndim
-          if (solver%fixed(j, i)) then
-             solver%a(j, i) = 0
-             solver%reaction(j, i) = solver%f_int(j, i) - solver%f_ext(j, i)
-          else if (solver%mass(i) <= 0) then
-             ! A node no element uses (a rigid body's reference node, held by rank 0) has no
-             ! mass and no forces: it does not move unless prescribed.
-             solver%a(j, i) = 0
-             solver%reaction(j, i) = 0
-          else
-             solver%a(j, i) = (solver%f_ext(j, i) - solver%f_int(j, i)) / solver%mass(i)
-             solver%reaction(j, i) = 0
-          end if
+          call dof_acceleration(solver%fixed(j, i), solver%mass(i), solver%f_int(j, i), solver%f_ext(j, i), &
+               solver%a(j, i), solver%reaction(j, i))
        end do
     end do
   end subroutine update_accelerations
+
+  !> Acceleration and reaction of one dof (update_accelerations, finish_nodes_kernel).
+  elemental subroutine dof_acceleration(fixed, mass, f_int, f_ext, a, reaction)
+    logical, intent(in) :: fixed
+    real(dp), intent(in) :: mass, f_int, f_ext
+    real(dp), intent(out) :: a, reaction
+
+    if (fixed) then
+       a = 0
+       reaction = f_int - f_ext
+    else if (mass <= 0) then
+       ! A node no element uses (a rigid body's reference node, held by rank 0) has no
+       ! mass and no forces: it does not move unless prescribed.
+       a = 0
+       reaction = 0
+    else
+       a = (f_ext - f_int) / mass
+       reaction = 0
+    end if
+  end subroutine dof_acceleration
+
+  !> Does a gravity load of the step have an amplitude (f_ext changes within the step)?
+  pure logical function gravity_has_amplitude(loads)
+    type(step_loads_t), intent(in) :: loads
+    integer :: g
+
+    gravity_has_amplitude = .false.
+    if (.not. allocated(loads%gravity)) return
+    do g = 1, size(loads%gravity)
+       if (loads%gravity(g)%amplitude > 0) gravity_has_amplitude = .true.
+    end do
+  end function gravity_has_amplitude
 
   subroutine write_outputs(m, solver, out, effects, istep)
     type(model_t), intent(in) :: m

@@ -50,17 +50,31 @@ contains
     integer, intent(in) :: nb
     real(dp), intent(in) :: xe(nb, 3, 8)
     real(dp), intent(out) :: a(nb, 3, 7)
-    integer :: k, i, n
-
-    a = 0.0_dp
-    do k = 1, 7
-       do n = 1, 8
-          do i = 1, 3
-             a(:, i, k) = a(:, i, k) + cn(n, k) * xe(:, i, n)
-          end do
-       end do
-    end do
-    a = 0.125_dp * a
+    ! a_k = ⅛ Σ_I c_kI x_I with c_kI = ±1 written out as additions and subtractions: the same
+    ! sums in the same order as Σ_I (c_kI x_I) from 0 (c x = ±x exactly, 0 + (−x) = 0 − x), so
+    ! bitwise the same a_k, in one pass per coefficient instead of eight read-modify-write
+    ! passes with multiplications. (The signs are those of cn, column k.)
+    a(:, 1, 1) = 0.125_dp * ((((((((0.0_dp - xe(:, 1, 1)) + xe(:, 1, 2)) + xe(:, 1, 3)) - xe(:, 1, 4)) - xe(:, 1, 5)) + xe(:, 1, 6)) + xe(:, 1, 7)) - xe(:, 1, 8))
+    a(:, 2, 1) = 0.125_dp * ((((((((0.0_dp - xe(:, 2, 1)) + xe(:, 2, 2)) + xe(:, 2, 3)) - xe(:, 2, 4)) - xe(:, 2, 5)) + xe(:, 2, 6)) + xe(:, 2, 7)) - xe(:, 2, 8))
+    a(:, 3, 1) = 0.125_dp * ((((((((0.0_dp - xe(:, 3, 1)) + xe(:, 3, 2)) + xe(:, 3, 3)) - xe(:, 3, 4)) - xe(:, 3, 5)) + xe(:, 3, 6)) + xe(:, 3, 7)) - xe(:, 3, 8))
+    a(:, 1, 2) = 0.125_dp * ((((((((0.0_dp - xe(:, 1, 1)) - xe(:, 1, 2)) + xe(:, 1, 3)) + xe(:, 1, 4)) - xe(:, 1, 5)) - xe(:, 1, 6)) + xe(:, 1, 7)) + xe(:, 1, 8))
+    a(:, 2, 2) = 0.125_dp * ((((((((0.0_dp - xe(:, 2, 1)) - xe(:, 2, 2)) + xe(:, 2, 3)) + xe(:, 2, 4)) - xe(:, 2, 5)) - xe(:, 2, 6)) + xe(:, 2, 7)) + xe(:, 2, 8))
+    a(:, 3, 2) = 0.125_dp * ((((((((0.0_dp - xe(:, 3, 1)) - xe(:, 3, 2)) + xe(:, 3, 3)) + xe(:, 3, 4)) - xe(:, 3, 5)) - xe(:, 3, 6)) + xe(:, 3, 7)) + xe(:, 3, 8))
+    a(:, 1, 3) = 0.125_dp * ((((((((0.0_dp - xe(:, 1, 1)) - xe(:, 1, 2)) - xe(:, 1, 3)) - xe(:, 1, 4)) + xe(:, 1, 5)) + xe(:, 1, 6)) + xe(:, 1, 7)) + xe(:, 1, 8))
+    a(:, 2, 3) = 0.125_dp * ((((((((0.0_dp - xe(:, 2, 1)) - xe(:, 2, 2)) - xe(:, 2, 3)) - xe(:, 2, 4)) + xe(:, 2, 5)) + xe(:, 2, 6)) + xe(:, 2, 7)) + xe(:, 2, 8))
+    a(:, 3, 3) = 0.125_dp * ((((((((0.0_dp - xe(:, 3, 1)) - xe(:, 3, 2)) - xe(:, 3, 3)) - xe(:, 3, 4)) + xe(:, 3, 5)) + xe(:, 3, 6)) + xe(:, 3, 7)) + xe(:, 3, 8))
+    a(:, 1, 4) = 0.125_dp * ((((((((0.0_dp + xe(:, 1, 1)) - xe(:, 1, 2)) + xe(:, 1, 3)) - xe(:, 1, 4)) + xe(:, 1, 5)) - xe(:, 1, 6)) + xe(:, 1, 7)) - xe(:, 1, 8))
+    a(:, 2, 4) = 0.125_dp * ((((((((0.0_dp + xe(:, 2, 1)) - xe(:, 2, 2)) + xe(:, 2, 3)) - xe(:, 2, 4)) + xe(:, 2, 5)) - xe(:, 2, 6)) + xe(:, 2, 7)) - xe(:, 2, 8))
+    a(:, 3, 4) = 0.125_dp * ((((((((0.0_dp + xe(:, 3, 1)) - xe(:, 3, 2)) + xe(:, 3, 3)) - xe(:, 3, 4)) + xe(:, 3, 5)) - xe(:, 3, 6)) + xe(:, 3, 7)) - xe(:, 3, 8))
+    a(:, 1, 5) = 0.125_dp * ((((((((0.0_dp + xe(:, 1, 1)) + xe(:, 1, 2)) - xe(:, 1, 3)) - xe(:, 1, 4)) - xe(:, 1, 5)) - xe(:, 1, 6)) + xe(:, 1, 7)) + xe(:, 1, 8))
+    a(:, 2, 5) = 0.125_dp * ((((((((0.0_dp + xe(:, 2, 1)) + xe(:, 2, 2)) - xe(:, 2, 3)) - xe(:, 2, 4)) - xe(:, 2, 5)) - xe(:, 2, 6)) + xe(:, 2, 7)) + xe(:, 2, 8))
+    a(:, 3, 5) = 0.125_dp * ((((((((0.0_dp + xe(:, 3, 1)) + xe(:, 3, 2)) - xe(:, 3, 3)) - xe(:, 3, 4)) - xe(:, 3, 5)) - xe(:, 3, 6)) + xe(:, 3, 7)) + xe(:, 3, 8))
+    a(:, 1, 6) = 0.125_dp * ((((((((0.0_dp + xe(:, 1, 1)) - xe(:, 1, 2)) - xe(:, 1, 3)) + xe(:, 1, 4)) - xe(:, 1, 5)) + xe(:, 1, 6)) + xe(:, 1, 7)) - xe(:, 1, 8))
+    a(:, 2, 6) = 0.125_dp * ((((((((0.0_dp + xe(:, 2, 1)) - xe(:, 2, 2)) - xe(:, 2, 3)) + xe(:, 2, 4)) - xe(:, 2, 5)) + xe(:, 2, 6)) + xe(:, 2, 7)) - xe(:, 2, 8))
+    a(:, 3, 6) = 0.125_dp * ((((((((0.0_dp + xe(:, 3, 1)) - xe(:, 3, 2)) - xe(:, 3, 3)) + xe(:, 3, 4)) - xe(:, 3, 5)) + xe(:, 3, 6)) + xe(:, 3, 7)) - xe(:, 3, 8))
+    a(:, 1, 7) = 0.125_dp * ((((((((0.0_dp - xe(:, 1, 1)) + xe(:, 1, 2)) - xe(:, 1, 3)) + xe(:, 1, 4)) + xe(:, 1, 5)) - xe(:, 1, 6)) + xe(:, 1, 7)) - xe(:, 1, 8))
+    a(:, 2, 7) = 0.125_dp * ((((((((0.0_dp - xe(:, 2, 1)) + xe(:, 2, 2)) - xe(:, 2, 3)) + xe(:, 2, 4)) + xe(:, 2, 5)) - xe(:, 2, 6)) + xe(:, 2, 7)) - xe(:, 2, 8))
+    a(:, 3, 7) = 0.125_dp * ((((((((0.0_dp - xe(:, 3, 1)) + xe(:, 3, 2)) - xe(:, 3, 3)) + xe(:, 3, 4)) + xe(:, 3, 5)) - xe(:, 3, 6)) + xe(:, 3, 7)) - xe(:, 3, 8))
   end subroutine map_coefficients
 
   !> p × q for blocks of vectors (nb, 3).
@@ -82,7 +96,7 @@ contains
     real(dp), intent(out) :: bmat(nb, 3, 8)
     real(dp) :: a(nb, 3, 7), g(nb, 3, 6), rv(nb)
     real(dp), parameter :: third = 1.0_dp / 3.0_dp
-    integer :: k, n, i
+    integer :: k, i
 
     call map_coefficients(nb, xe, a)
     g(:, :, 1) = cross(nb, a(:, :, 2), a(:, :, 3)) + third * cross(nb, a(:, :, 4), a(:, :, 6))
@@ -101,17 +115,32 @@ contains
     volume = (8.0_dp / 3.0_dp) * volume
     ! A degenerate element (V = 0) is caught by the inversion check; avoid 1/0 here.
     rv = 1.0_dp / sign(max(abs(volume), tiny(1.0_dp)), volume)
-    bmat = 0.0_dp
-    do n = 1, 8
-       do k = 1, 6
-          do i = 1, 3
-             bmat(:, i, n) = bmat(:, i, n) + cn(n, k) * g(:, i, k)
-          end do
-       end do
-       do i = 1, 3
-          bmat(:, i, n) = bmat(:, i, n) * rv
-       end do
-    end do
+    ! B_iI = (Σ_k c_kI g_ik) / V with c_kI = ±1 written out (as in map_coefficients: the same
+    ! sums in the same order, bitwise the same B, one pass per entry).
+    bmat(:, 1, 1) = ((((((0.0_dp - g(:, 1, 1)) - g(:, 1, 2)) - g(:, 1, 3)) + g(:, 1, 4)) + g(:, 1, 5)) + g(:, 1, 6)) * rv
+    bmat(:, 2, 1) = ((((((0.0_dp - g(:, 2, 1)) - g(:, 2, 2)) - g(:, 2, 3)) + g(:, 2, 4)) + g(:, 2, 5)) + g(:, 2, 6)) * rv
+    bmat(:, 3, 1) = ((((((0.0_dp - g(:, 3, 1)) - g(:, 3, 2)) - g(:, 3, 3)) + g(:, 3, 4)) + g(:, 3, 5)) + g(:, 3, 6)) * rv
+    bmat(:, 1, 2) = ((((((0.0_dp + g(:, 1, 1)) - g(:, 1, 2)) - g(:, 1, 3)) - g(:, 1, 4)) + g(:, 1, 5)) - g(:, 1, 6)) * rv
+    bmat(:, 2, 2) = ((((((0.0_dp + g(:, 2, 1)) - g(:, 2, 2)) - g(:, 2, 3)) - g(:, 2, 4)) + g(:, 2, 5)) - g(:, 2, 6)) * rv
+    bmat(:, 3, 2) = ((((((0.0_dp + g(:, 3, 1)) - g(:, 3, 2)) - g(:, 3, 3)) - g(:, 3, 4)) + g(:, 3, 5)) - g(:, 3, 6)) * rv
+    bmat(:, 1, 3) = ((((((0.0_dp + g(:, 1, 1)) + g(:, 1, 2)) - g(:, 1, 3)) + g(:, 1, 4)) - g(:, 1, 5)) - g(:, 1, 6)) * rv
+    bmat(:, 2, 3) = ((((((0.0_dp + g(:, 2, 1)) + g(:, 2, 2)) - g(:, 2, 3)) + g(:, 2, 4)) - g(:, 2, 5)) - g(:, 2, 6)) * rv
+    bmat(:, 3, 3) = ((((((0.0_dp + g(:, 3, 1)) + g(:, 3, 2)) - g(:, 3, 3)) + g(:, 3, 4)) - g(:, 3, 5)) - g(:, 3, 6)) * rv
+    bmat(:, 1, 4) = ((((((0.0_dp - g(:, 1, 1)) + g(:, 1, 2)) - g(:, 1, 3)) - g(:, 1, 4)) - g(:, 1, 5)) + g(:, 1, 6)) * rv
+    bmat(:, 2, 4) = ((((((0.0_dp - g(:, 2, 1)) + g(:, 2, 2)) - g(:, 2, 3)) - g(:, 2, 4)) - g(:, 2, 5)) + g(:, 2, 6)) * rv
+    bmat(:, 3, 4) = ((((((0.0_dp - g(:, 3, 1)) + g(:, 3, 2)) - g(:, 3, 3)) - g(:, 3, 4)) - g(:, 3, 5)) + g(:, 3, 6)) * rv
+    bmat(:, 1, 5) = ((((((0.0_dp - g(:, 1, 1)) - g(:, 1, 2)) + g(:, 1, 3)) + g(:, 1, 4)) - g(:, 1, 5)) - g(:, 1, 6)) * rv
+    bmat(:, 2, 5) = ((((((0.0_dp - g(:, 2, 1)) - g(:, 2, 2)) + g(:, 2, 3)) + g(:, 2, 4)) - g(:, 2, 5)) - g(:, 2, 6)) * rv
+    bmat(:, 3, 5) = ((((((0.0_dp - g(:, 3, 1)) - g(:, 3, 2)) + g(:, 3, 3)) + g(:, 3, 4)) - g(:, 3, 5)) - g(:, 3, 6)) * rv
+    bmat(:, 1, 6) = ((((((0.0_dp + g(:, 1, 1)) - g(:, 1, 2)) + g(:, 1, 3)) - g(:, 1, 4)) - g(:, 1, 5)) + g(:, 1, 6)) * rv
+    bmat(:, 2, 6) = ((((((0.0_dp + g(:, 2, 1)) - g(:, 2, 2)) + g(:, 2, 3)) - g(:, 2, 4)) - g(:, 2, 5)) + g(:, 2, 6)) * rv
+    bmat(:, 3, 6) = ((((((0.0_dp + g(:, 3, 1)) - g(:, 3, 2)) + g(:, 3, 3)) - g(:, 3, 4)) - g(:, 3, 5)) + g(:, 3, 6)) * rv
+    bmat(:, 1, 7) = ((((((0.0_dp + g(:, 1, 1)) + g(:, 1, 2)) + g(:, 1, 3)) + g(:, 1, 4)) + g(:, 1, 5)) + g(:, 1, 6)) * rv
+    bmat(:, 2, 7) = ((((((0.0_dp + g(:, 2, 1)) + g(:, 2, 2)) + g(:, 2, 3)) + g(:, 2, 4)) + g(:, 2, 5)) + g(:, 2, 6)) * rv
+    bmat(:, 3, 7) = ((((((0.0_dp + g(:, 3, 1)) + g(:, 3, 2)) + g(:, 3, 3)) + g(:, 3, 4)) + g(:, 3, 5)) + g(:, 3, 6)) * rv
+    bmat(:, 1, 8) = ((((((0.0_dp - g(:, 1, 1)) + g(:, 1, 2)) + g(:, 1, 3)) - g(:, 1, 4)) + g(:, 1, 5)) - g(:, 1, 6)) * rv
+    bmat(:, 2, 8) = ((((((0.0_dp - g(:, 2, 1)) + g(:, 2, 2)) + g(:, 2, 3)) - g(:, 2, 4)) + g(:, 2, 5)) - g(:, 2, 6)) * rv
+    bmat(:, 3, 8) = ((((((0.0_dp - g(:, 3, 1)) + g(:, 3, 2)) + g(:, 3, 3)) - g(:, 3, 4)) + g(:, 3, 5)) - g(:, 3, 6)) * rv
   end subroutine c3d8r_geometry
 
   !> Characteristic length L_e = V / (largest face area) (LS-DYNA's choice for hexahedra),
@@ -146,16 +175,18 @@ contains
     real(dp), intent(out) :: strain_inc(nb, 6)
     real(dp), intent(out) :: spin_inc(nb, 3)
     real(dp) :: dl(nb, 3, 3)
-    integer :: i, j, n
 
-    dl = 0.0_dp
-    do n = 1, 8
-       do j = 1, 3
-          do i = 1, 3
-             dl(:, i, j) = dl(:, i, j) + du(:, i, n) * bmat_mid(:, j, n)
-          end do
-       end do
-    end do
+    ! ΔL_ij = Σ_I du_iI B_jI, each in one pass with the sum over the nodes in node order from 0
+    ! (the order of the former node loop: bitwise the same).
+    dl(:, 1, 1) = (((((((0.0_dp + du(:, 1, 1) * bmat_mid(:, 1, 1)) + du(:, 1, 2) * bmat_mid(:, 1, 2)) + du(:, 1, 3) * bmat_mid(:, 1, 3)) + du(:, 1, 4) * bmat_mid(:, 1, 4)) + du(:, 1, 5) * bmat_mid(:, 1, 5)) + du(:, 1, 6) * bmat_mid(:, 1, 6)) + du(:, 1, 7) * bmat_mid(:, 1, 7)) + du(:, 1, 8) * bmat_mid(:, 1, 8)
+    dl(:, 2, 1) = (((((((0.0_dp + du(:, 2, 1) * bmat_mid(:, 1, 1)) + du(:, 2, 2) * bmat_mid(:, 1, 2)) + du(:, 2, 3) * bmat_mid(:, 1, 3)) + du(:, 2, 4) * bmat_mid(:, 1, 4)) + du(:, 2, 5) * bmat_mid(:, 1, 5)) + du(:, 2, 6) * bmat_mid(:, 1, 6)) + du(:, 2, 7) * bmat_mid(:, 1, 7)) + du(:, 2, 8) * bmat_mid(:, 1, 8)
+    dl(:, 3, 1) = (((((((0.0_dp + du(:, 3, 1) * bmat_mid(:, 1, 1)) + du(:, 3, 2) * bmat_mid(:, 1, 2)) + du(:, 3, 3) * bmat_mid(:, 1, 3)) + du(:, 3, 4) * bmat_mid(:, 1, 4)) + du(:, 3, 5) * bmat_mid(:, 1, 5)) + du(:, 3, 6) * bmat_mid(:, 1, 6)) + du(:, 3, 7) * bmat_mid(:, 1, 7)) + du(:, 3, 8) * bmat_mid(:, 1, 8)
+    dl(:, 1, 2) = (((((((0.0_dp + du(:, 1, 1) * bmat_mid(:, 2, 1)) + du(:, 1, 2) * bmat_mid(:, 2, 2)) + du(:, 1, 3) * bmat_mid(:, 2, 3)) + du(:, 1, 4) * bmat_mid(:, 2, 4)) + du(:, 1, 5) * bmat_mid(:, 2, 5)) + du(:, 1, 6) * bmat_mid(:, 2, 6)) + du(:, 1, 7) * bmat_mid(:, 2, 7)) + du(:, 1, 8) * bmat_mid(:, 2, 8)
+    dl(:, 2, 2) = (((((((0.0_dp + du(:, 2, 1) * bmat_mid(:, 2, 1)) + du(:, 2, 2) * bmat_mid(:, 2, 2)) + du(:, 2, 3) * bmat_mid(:, 2, 3)) + du(:, 2, 4) * bmat_mid(:, 2, 4)) + du(:, 2, 5) * bmat_mid(:, 2, 5)) + du(:, 2, 6) * bmat_mid(:, 2, 6)) + du(:, 2, 7) * bmat_mid(:, 2, 7)) + du(:, 2, 8) * bmat_mid(:, 2, 8)
+    dl(:, 3, 2) = (((((((0.0_dp + du(:, 3, 1) * bmat_mid(:, 2, 1)) + du(:, 3, 2) * bmat_mid(:, 2, 2)) + du(:, 3, 3) * bmat_mid(:, 2, 3)) + du(:, 3, 4) * bmat_mid(:, 2, 4)) + du(:, 3, 5) * bmat_mid(:, 2, 5)) + du(:, 3, 6) * bmat_mid(:, 2, 6)) + du(:, 3, 7) * bmat_mid(:, 2, 7)) + du(:, 3, 8) * bmat_mid(:, 2, 8)
+    dl(:, 1, 3) = (((((((0.0_dp + du(:, 1, 1) * bmat_mid(:, 3, 1)) + du(:, 1, 2) * bmat_mid(:, 3, 2)) + du(:, 1, 3) * bmat_mid(:, 3, 3)) + du(:, 1, 4) * bmat_mid(:, 3, 4)) + du(:, 1, 5) * bmat_mid(:, 3, 5)) + du(:, 1, 6) * bmat_mid(:, 3, 6)) + du(:, 1, 7) * bmat_mid(:, 3, 7)) + du(:, 1, 8) * bmat_mid(:, 3, 8)
+    dl(:, 2, 3) = (((((((0.0_dp + du(:, 2, 1) * bmat_mid(:, 3, 1)) + du(:, 2, 2) * bmat_mid(:, 3, 2)) + du(:, 2, 3) * bmat_mid(:, 3, 3)) + du(:, 2, 4) * bmat_mid(:, 3, 4)) + du(:, 2, 5) * bmat_mid(:, 3, 5)) + du(:, 2, 6) * bmat_mid(:, 3, 6)) + du(:, 2, 7) * bmat_mid(:, 3, 7)) + du(:, 2, 8) * bmat_mid(:, 3, 8)
+    dl(:, 3, 3) = (((((((0.0_dp + du(:, 3, 1) * bmat_mid(:, 3, 1)) + du(:, 3, 2) * bmat_mid(:, 3, 2)) + du(:, 3, 3) * bmat_mid(:, 3, 3)) + du(:, 3, 4) * bmat_mid(:, 3, 4)) + du(:, 3, 5) * bmat_mid(:, 3, 5)) + du(:, 3, 6) * bmat_mid(:, 3, 6)) + du(:, 3, 7) * bmat_mid(:, 3, 7)) + du(:, 3, 8) * bmat_mid(:, 3, 8)
     strain_inc(:, 1) = dl(:, 1, 1)
     strain_inc(:, 2) = dl(:, 2, 2)
     strain_inc(:, 3) = dl(:, 3, 3)

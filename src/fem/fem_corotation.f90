@@ -28,6 +28,8 @@ module fem_corotation
   !> iterate is then orthogonal to ~1e-16 after the extra final step), or after max_newton.
   real(dp), parameter :: newton_tolerance = 1.0e-10_dp
   integer, parameter :: max_newton = 60
+  !> Elements per chunk of the 3D polar decomposition (polar_rotation_3d).
+  integer, parameter :: polar_chunk = 32
 
 contains
 
@@ -47,8 +49,15 @@ contains
     real(dp), intent(in) :: r_old(nb, ndim, ndim)
     real(dp), intent(out) :: r_mid(nb, ndim, ndim), r_new(nb, ndim, ndim), f_new(nb, ndim, ndim)
     real(dp), intent(out) :: strain_inc_corot(nb, 2 * ndim), rel_spin(nb, 2 * ndim - 3)
-    real(dp) :: f_mid(nb, ndim, ndim)
+    real(dp), allocatable :: f_mid(:, :, :)
 
+    if (ndim == 2 .and. nen == 4) then
+       call corotational_increment_2d(nb, bmat_ref, xe_mid, xe_new, strain_inc, spin_inc, r_old, &
+            r_mid, r_new, f_new, strain_inc_corot, rel_spin)
+       return
+    end if
+    ! 3D: F_{n+½} is only needed here (allocated, not automatic: the 2D path needs no memory).
+    allocate(f_mid(nb, ndim, ndim))
     call deformation_gradient(nb, ndim, nen, bmat_ref, xe_mid, f_mid)
     call polar_rotation(nb, ndim, f_mid, r_mid)
     call deformation_gradient(nb, ndim, nen, bmat_ref, xe_new, f_new)
@@ -56,6 +65,100 @@ contains
     call to_corotational(nb, ndim, 2 * ndim, r_mid, strain_inc, strain_inc_corot)
     call relative_spin(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
   end subroutine corotational_increment
+
+  !> corotational_increment for CPE4R as one element loop on scalars: F_{n+½} and R_{n+½} never
+  !> leave registers, and each element's data is read once (before: six passes over the block
+  !> and a heap-allocated F_{n+½}). Every quantity is the same sum, in the same order, as in
+  !> deformation_gradient, polar_rotation, rotate_symmetric_2d and relative_spin, so the results
+  !> are the same to the bit.
+  pure subroutine corotational_increment_2d(nb, bmat_ref, xe_mid, xe_new, strain_inc, spin_inc, &
+                                            r_old, r_mid, r_new, f_new, strain_inc_corot, rel_spin)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: bmat_ref(nb, 2, 4)
+    real(dp), intent(in) :: xe_mid(nb, 2, 4), xe_new(nb, 2, 4)
+    real(dp), intent(in) :: strain_inc(nb, 4), spin_inc(nb, 1)
+    real(dp), intent(in) :: r_old(nb, 2, 2)
+    real(dp), intent(out) :: r_mid(nb, 2, 2), r_new(nb, 2, 2), f_new(nb, 2, 2)
+    real(dp), intent(out) :: strain_inc_corot(nb, 4), rel_spin(nb, 1)
+    real(dp) :: x2, x3, x4, y2, y3, y4, f11, f21, f12, f22, c, s, nrm
+    real(dp) :: q11, q12, q21, q22, a11, a22, a12, t11, t12, t21, t22, u12, u21
+    real(dp) :: n11, n12, n21, n22, d11, d22, d12, d21
+    integer :: e
+
+    ! ivdep: the dummies do not alias (Fortran); without it the compiler wanted more run-time
+    ! alias checks than its limit and left the loop scalar.
+    !GCC$ ivdep
+    do e = 1, nb
+       ! F_{n+½} and R_{n+½} (deformation_gradient, polar_rotation)
+       x2 = xe_mid(e, 1, 2) - xe_mid(e, 1, 1)
+       x3 = xe_mid(e, 1, 3) - xe_mid(e, 1, 1)
+       x4 = xe_mid(e, 1, 4) - xe_mid(e, 1, 1)
+       y2 = xe_mid(e, 2, 2) - xe_mid(e, 2, 1)
+       y3 = xe_mid(e, 2, 3) - xe_mid(e, 2, 1)
+       y4 = xe_mid(e, 2, 4) - xe_mid(e, 2, 1)
+       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
+       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
+       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
+       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       c = f11 + f22
+       s = f21 - f12
+       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
+       q11 = c / nrm
+       q21 = s / nrm
+       q12 = -s / nrm
+       q22 = c / nrm
+       r_mid(e, 1, 1) = q11
+       r_mid(e, 2, 1) = q21
+       r_mid(e, 1, 2) = q12
+       r_mid(e, 2, 2) = q22
+       ! F_{n+1} and R_{n+1}
+       x2 = xe_new(e, 1, 2) - xe_new(e, 1, 1)
+       x3 = xe_new(e, 1, 3) - xe_new(e, 1, 1)
+       x4 = xe_new(e, 1, 4) - xe_new(e, 1, 1)
+       y2 = xe_new(e, 2, 2) - xe_new(e, 2, 1)
+       y3 = xe_new(e, 2, 3) - xe_new(e, 2, 1)
+       y4 = xe_new(e, 2, 4) - xe_new(e, 2, 1)
+       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
+       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
+       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
+       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       f_new(e, 1, 1) = f11
+       f_new(e, 2, 1) = f21
+       f_new(e, 1, 2) = f12
+       f_new(e, 2, 2) = f22
+       c = f11 + f22
+       s = f21 - f12
+       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
+       n11 = c / nrm
+       n21 = s / nrm
+       n12 = -s / nrm
+       n22 = c / nrm
+       r_new(e, 1, 1) = n11
+       r_new(e, 2, 1) = n21
+       r_new(e, 1, 2) = n12
+       r_new(e, 2, 2) = n22
+       ! strainInc = R_{n+½}ᵀ Δε R_{n+½} (rotate_symmetric_2d with q = R_{n+½}ᵀ: q12 = R21, q21 = R12)
+       a11 = strain_inc(e, 1)
+       a22 = strain_inc(e, 2)
+       a12 = strain_inc(e, 4)
+       t11 = (0.0_dp + a11 * q11) + a12 * q21
+       t12 = (0.0_dp + a11 * q12) + a12 * q22
+       t21 = (0.0_dp + a12 * q11) + a22 * q21
+       t22 = (0.0_dp + a12 * q12) + a22 * q22
+       strain_inc_corot(e, 1) = (0.0_dp + q11 * t11) + q21 * t21
+       strain_inc_corot(e, 2) = (0.0_dp + q12 * t12) + q22 * t22
+       strain_inc_corot(e, 3) = strain_inc(e, 3)
+       u12 = (0.0_dp + q11 * t12) + q21 * t22
+       u21 = (0.0_dp + q12 * t11) + q22 * t21
+       strain_inc_corot(e, 4) = 0.5_dp * (u12 + u21)
+       ! relSpinInc (relative_spin): ΔR = R_{n+1} R_nᵀ
+       d11 = (0.0_dp + n11 * r_old(e, 1, 1)) + n12 * r_old(e, 1, 2)
+       d22 = (0.0_dp + n21 * r_old(e, 2, 1)) + n22 * r_old(e, 2, 2)
+       d12 = (0.0_dp + n11 * r_old(e, 2, 1)) + n12 * r_old(e, 2, 2)
+       d21 = (0.0_dp + n21 * r_old(e, 1, 1)) + n22 * r_old(e, 1, 2)
+       rel_spin(e, 1) = spin_inc(e, 1) - 2.0_dp * (d21 - d12) / (2.0_dp + d11 + d22)
+    end do
+  end subroutine corotational_increment_2d
 
   !> Mean deformation gradient F = Σ_I x_I ⊗ B0_I of a block, B0 the mean gradient of the
   !> reference configuration (fem_cpe4r/fem_c3d8r geometry on x0). Exact for linear fields.
@@ -84,6 +187,20 @@ contains
           f(e, 1, 2) = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
           f(e, 2, 2) = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
        end do
+       return
+    end if
+    if (ndim == 3 .and. nen == 8) then
+       ! C3D8R: each F_ij in one pass, the sum over the nodes written out in the order of the
+       ! general loop below (bitwise the same F), instead of seven read-modify-write passes.
+       f(:, 1, 1) = ((((((0.0_dp + (xe(:, 1, 2) - xe(:, 1, 1)) * bmat_ref(:, 1, 2)) + (xe(:, 1, 3) - xe(:, 1, 1)) * bmat_ref(:, 1, 3)) + (xe(:, 1, 4) - xe(:, 1, 1)) * bmat_ref(:, 1, 4)) + (xe(:, 1, 5) - xe(:, 1, 1)) * bmat_ref(:, 1, 5)) + (xe(:, 1, 6) - xe(:, 1, 1)) * bmat_ref(:, 1, 6)) + (xe(:, 1, 7) - xe(:, 1, 1)) * bmat_ref(:, 1, 7)) + (xe(:, 1, 8) - xe(:, 1, 1)) * bmat_ref(:, 1, 8)
+       f(:, 2, 1) = ((((((0.0_dp + (xe(:, 2, 2) - xe(:, 2, 1)) * bmat_ref(:, 1, 2)) + (xe(:, 2, 3) - xe(:, 2, 1)) * bmat_ref(:, 1, 3)) + (xe(:, 2, 4) - xe(:, 2, 1)) * bmat_ref(:, 1, 4)) + (xe(:, 2, 5) - xe(:, 2, 1)) * bmat_ref(:, 1, 5)) + (xe(:, 2, 6) - xe(:, 2, 1)) * bmat_ref(:, 1, 6)) + (xe(:, 2, 7) - xe(:, 2, 1)) * bmat_ref(:, 1, 7)) + (xe(:, 2, 8) - xe(:, 2, 1)) * bmat_ref(:, 1, 8)
+       f(:, 3, 1) = ((((((0.0_dp + (xe(:, 3, 2) - xe(:, 3, 1)) * bmat_ref(:, 1, 2)) + (xe(:, 3, 3) - xe(:, 3, 1)) * bmat_ref(:, 1, 3)) + (xe(:, 3, 4) - xe(:, 3, 1)) * bmat_ref(:, 1, 4)) + (xe(:, 3, 5) - xe(:, 3, 1)) * bmat_ref(:, 1, 5)) + (xe(:, 3, 6) - xe(:, 3, 1)) * bmat_ref(:, 1, 6)) + (xe(:, 3, 7) - xe(:, 3, 1)) * bmat_ref(:, 1, 7)) + (xe(:, 3, 8) - xe(:, 3, 1)) * bmat_ref(:, 1, 8)
+       f(:, 1, 2) = ((((((0.0_dp + (xe(:, 1, 2) - xe(:, 1, 1)) * bmat_ref(:, 2, 2)) + (xe(:, 1, 3) - xe(:, 1, 1)) * bmat_ref(:, 2, 3)) + (xe(:, 1, 4) - xe(:, 1, 1)) * bmat_ref(:, 2, 4)) + (xe(:, 1, 5) - xe(:, 1, 1)) * bmat_ref(:, 2, 5)) + (xe(:, 1, 6) - xe(:, 1, 1)) * bmat_ref(:, 2, 6)) + (xe(:, 1, 7) - xe(:, 1, 1)) * bmat_ref(:, 2, 7)) + (xe(:, 1, 8) - xe(:, 1, 1)) * bmat_ref(:, 2, 8)
+       f(:, 2, 2) = ((((((0.0_dp + (xe(:, 2, 2) - xe(:, 2, 1)) * bmat_ref(:, 2, 2)) + (xe(:, 2, 3) - xe(:, 2, 1)) * bmat_ref(:, 2, 3)) + (xe(:, 2, 4) - xe(:, 2, 1)) * bmat_ref(:, 2, 4)) + (xe(:, 2, 5) - xe(:, 2, 1)) * bmat_ref(:, 2, 5)) + (xe(:, 2, 6) - xe(:, 2, 1)) * bmat_ref(:, 2, 6)) + (xe(:, 2, 7) - xe(:, 2, 1)) * bmat_ref(:, 2, 7)) + (xe(:, 2, 8) - xe(:, 2, 1)) * bmat_ref(:, 2, 8)
+       f(:, 3, 2) = ((((((0.0_dp + (xe(:, 3, 2) - xe(:, 3, 1)) * bmat_ref(:, 2, 2)) + (xe(:, 3, 3) - xe(:, 3, 1)) * bmat_ref(:, 2, 3)) + (xe(:, 3, 4) - xe(:, 3, 1)) * bmat_ref(:, 2, 4)) + (xe(:, 3, 5) - xe(:, 3, 1)) * bmat_ref(:, 2, 5)) + (xe(:, 3, 6) - xe(:, 3, 1)) * bmat_ref(:, 2, 6)) + (xe(:, 3, 7) - xe(:, 3, 1)) * bmat_ref(:, 2, 7)) + (xe(:, 3, 8) - xe(:, 3, 1)) * bmat_ref(:, 2, 8)
+       f(:, 1, 3) = ((((((0.0_dp + (xe(:, 1, 2) - xe(:, 1, 1)) * bmat_ref(:, 3, 2)) + (xe(:, 1, 3) - xe(:, 1, 1)) * bmat_ref(:, 3, 3)) + (xe(:, 1, 4) - xe(:, 1, 1)) * bmat_ref(:, 3, 4)) + (xe(:, 1, 5) - xe(:, 1, 1)) * bmat_ref(:, 3, 5)) + (xe(:, 1, 6) - xe(:, 1, 1)) * bmat_ref(:, 3, 6)) + (xe(:, 1, 7) - xe(:, 1, 1)) * bmat_ref(:, 3, 7)) + (xe(:, 1, 8) - xe(:, 1, 1)) * bmat_ref(:, 3, 8)
+       f(:, 2, 3) = ((((((0.0_dp + (xe(:, 2, 2) - xe(:, 2, 1)) * bmat_ref(:, 3, 2)) + (xe(:, 2, 3) - xe(:, 2, 1)) * bmat_ref(:, 3, 3)) + (xe(:, 2, 4) - xe(:, 2, 1)) * bmat_ref(:, 3, 4)) + (xe(:, 2, 5) - xe(:, 2, 1)) * bmat_ref(:, 3, 5)) + (xe(:, 2, 6) - xe(:, 2, 1)) * bmat_ref(:, 3, 6)) + (xe(:, 2, 7) - xe(:, 2, 1)) * bmat_ref(:, 3, 7)) + (xe(:, 2, 8) - xe(:, 2, 1)) * bmat_ref(:, 3, 8)
+       f(:, 3, 3) = ((((((0.0_dp + (xe(:, 3, 2) - xe(:, 3, 1)) * bmat_ref(:, 3, 2)) + (xe(:, 3, 3) - xe(:, 3, 1)) * bmat_ref(:, 3, 3)) + (xe(:, 3, 4) - xe(:, 3, 1)) * bmat_ref(:, 3, 4)) + (xe(:, 3, 5) - xe(:, 3, 1)) * bmat_ref(:, 3, 5)) + (xe(:, 3, 6) - xe(:, 3, 1)) * bmat_ref(:, 3, 6)) + (xe(:, 3, 7) - xe(:, 3, 1)) * bmat_ref(:, 3, 7)) + (xe(:, 3, 8) - xe(:, 3, 1)) * bmat_ref(:, 3, 8)
        return
     end if
     f = 0.0_dp
@@ -134,65 +251,94 @@ contains
     integer, intent(in) :: nb
     real(dp), intent(in) :: f(nb, 3, 3)
     real(dp), intent(out) :: r(nb, 3, 3)
-    real(dp) :: cof(nb, 3, 3), det(nb), gam(nb), xnorm2(nb), cnorm2(nb), change(nb)
-    real(dp) :: xnew
-    integer :: it, i, j, e
+    integer :: e0
+
+    ! Chunks of fixed size: the work arrays live on the stack (block-sized automatic arrays
+    ! are heap-allocated by gfortran, seven per call here), stay in L1, and the iterations stop
+    ! when the chunk has converged instead of the whole block. Each element's iterates depend
+    ! on that element alone, so the result does not depend on the chunking.
+    do e0 = 1, nb, polar_chunk
+       call polar_rotation_3d_chunk(nb, e0, min(polar_chunk, nb - e0 + 1), f, r)
+    end do
+  end subroutine polar_rotation_3d
+
+  !> polar_rotation_3d on the n elements e0..e0+n-1 of the block, with the operations of the
+  !> former whole-block form in the same order (bitwise the same R). Each step is a loop over
+  !> the chunk that vectorises.
+  pure subroutine polar_rotation_3d_chunk(nb, e0, n, f, r)
+    integer, intent(in) :: nb, e0, n
+    real(dp), intent(in) :: f(nb, 3, 3)
+    real(dp), intent(inout) :: r(nb, 3, 3)
+    real(dp) :: x(polar_chunk, 3, 3), cof(polar_chunk, 3, 3), det(polar_chunk), gam(polar_chunk)
+    real(dp) :: change(polar_chunk)
+    real(dp) :: xnew, xnorm2, cnorm2, d
+    integer :: it, i, j, k
     ! Per element: 0 scaled iterations, 1 the final unscaled step, 2 converged (frozen). The
     ! stopping test is each element's own, so an element's R does not depend on which other
     ! elements share its block (and results do not depend on the number of MPI ranks).
-    integer :: stage(nb)
+    integer :: stage(polar_chunk)
 
-    r = f
-    stage = 0
-    do it = 1, max_newton
-       call cofactor(nb, r, cof, det)
-       ! Guard against an exactly singular (collapsed) element: no division by zero.
-       det = sign(max(abs(det), tiny(1.0_dp)), det)
-       xnorm2 = 0.0_dp
-       cnorm2 = 0.0_dp
-       do j = 1, 3
-          do i = 1, 3
-             xnorm2 = xnorm2 + r(:, i, j)**2
-             cnorm2 = cnorm2 + cof(:, i, j)**2
-          end do
+    do j = 1, 3
+       do i = 1, 3
+          x(1:n, i, j) = f(e0:e0 + n - 1, i, j)
        end do
-       ! γ = (‖X⁻¹‖_F / ‖X‖_F)^½ with ‖X⁻¹‖_F = ‖cof X‖_F / |det X|; 1 for the final step.
-       gam = merge(sqrt(sqrt(cnorm2 / max(xnorm2, tiny(1.0_dp))) / abs(det)), 1.0_dp, stage == 0)
-       change = 0.0_dp
+    end do
+    stage(1:n) = 0
+    do it = 1, max_newton
+       do k = 1, n
+          ! cofactor matrix (cof X)_ij = ∂det X/∂X_ij and det X
+          cof(k, 1, 1) = x(k, 2, 2) * x(k, 3, 3) - x(k, 2, 3) * x(k, 3, 2)
+          cof(k, 1, 2) = x(k, 2, 3) * x(k, 3, 1) - x(k, 2, 1) * x(k, 3, 3)
+          cof(k, 1, 3) = x(k, 2, 1) * x(k, 3, 2) - x(k, 2, 2) * x(k, 3, 1)
+          cof(k, 2, 1) = x(k, 1, 3) * x(k, 3, 2) - x(k, 1, 2) * x(k, 3, 3)
+          cof(k, 2, 2) = x(k, 1, 1) * x(k, 3, 3) - x(k, 1, 3) * x(k, 3, 1)
+          cof(k, 2, 3) = x(k, 1, 2) * x(k, 3, 1) - x(k, 1, 1) * x(k, 3, 2)
+          cof(k, 3, 1) = x(k, 1, 2) * x(k, 2, 3) - x(k, 1, 3) * x(k, 2, 2)
+          cof(k, 3, 2) = x(k, 1, 3) * x(k, 2, 1) - x(k, 1, 1) * x(k, 2, 3)
+          cof(k, 3, 3) = x(k, 1, 1) * x(k, 2, 2) - x(k, 1, 2) * x(k, 2, 1)
+          d = x(k, 1, 1) * cof(k, 1, 1) + x(k, 1, 2) * cof(k, 1, 2) + x(k, 1, 3) * cof(k, 1, 3)
+          ! Guard against an exactly singular (collapsed) element: no division by zero.
+          d = sign(max(abs(d), tiny(1.0_dp)), d)
+          det(k) = d
+          ! Frobenius norms, column by column
+          xnorm2 = ((((((((0.0_dp + x(k, 1, 1)**2) + x(k, 2, 1)**2) + x(k, 3, 1)**2) + x(k, 1, 2)**2) &
+               + x(k, 2, 2)**2) + x(k, 3, 2)**2) + x(k, 1, 3)**2) + x(k, 2, 3)**2) + x(k, 3, 3)**2
+          cnorm2 = ((((((((0.0_dp + cof(k, 1, 1)**2) + cof(k, 2, 1)**2) + cof(k, 3, 1)**2) &
+               + cof(k, 1, 2)**2) + cof(k, 2, 2)**2) + cof(k, 3, 2)**2) + cof(k, 1, 3)**2) &
+               + cof(k, 2, 3)**2) + cof(k, 3, 3)**2
+          ! γ = (‖X⁻¹‖_F / ‖X‖_F)^½ with ‖X⁻¹‖_F = ‖cof X‖_F / |det X|
+          gam(k) = sqrt(sqrt(cnorm2 / max(xnorm2, tiny(1.0_dp))) / abs(d))
+       end do
+       ! 1 for the final step. (Its own loop: in the one above the compiler moved the square
+       ! roots under a branch on the stage and could no longer vectorise.)
+       do k = 1, n
+          gam(k) = merge(gam(k), 1.0_dp, stage(k) == 0)
+       end do
+       change(1:n) = 0.0_dp
        do j = 1, 3
           do i = 1, 3
-             do e = 1, nb
+             do k = 1, n
                 ! X⁻ᵀ = cof(X) / det X
-                xnew = 0.5_dp * (gam(e) * r(e, i, j) + cof(e, i, j) / (gam(e) * det(e)))
-                change(e) = change(e) + (xnew - r(e, i, j))**2
-                r(e, i, j) = merge(xnew, r(e, i, j), stage(e) < 2)
+                xnew = 0.5_dp * (gam(k) * x(k, i, j) + cof(k, i, j) / (gam(k) * det(k)))
+                change(k) = change(k) + (xnew - x(k, i, j))**2
+                x(k, i, j) = merge(xnew, x(k, i, j), stage(k) < 2)
              end do
           end do
        end do
        ! Near convergence the scaling is switched off for one last plain Newton step, which
        ! restores full quadratic convergence to an orthogonal matrix.
-       stage = merge(stage + 1, stage, stage == 1 .or. (stage == 0 .and. change <= newton_tolerance**2))
-       if (all(stage == 2)) exit
+       do k = 1, n
+          stage(k) = merge(stage(k) + 1, stage(k), stage(k) == 1 .or. &
+               (stage(k) == 0 .and. change(k) <= newton_tolerance**2))
+       end do
+       if (all(stage(1:n) == 2)) exit
     end do
-  end subroutine polar_rotation_3d
-
-  !> Cofactor matrix (cof X)_ij = ∂det X/∂X_ij and det X of a block of 3×3 matrices.
-  pure subroutine cofactor(nb, x, cof, det)
-    integer, intent(in) :: nb
-    real(dp), intent(in) :: x(nb, 3, 3)
-    real(dp), intent(out) :: cof(nb, 3, 3), det(nb)
-
-    cof(:, 1, 1) = x(:, 2, 2) * x(:, 3, 3) - x(:, 2, 3) * x(:, 3, 2)
-    cof(:, 1, 2) = x(:, 2, 3) * x(:, 3, 1) - x(:, 2, 1) * x(:, 3, 3)
-    cof(:, 1, 3) = x(:, 2, 1) * x(:, 3, 2) - x(:, 2, 2) * x(:, 3, 1)
-    cof(:, 2, 1) = x(:, 1, 3) * x(:, 3, 2) - x(:, 1, 2) * x(:, 3, 3)
-    cof(:, 2, 2) = x(:, 1, 1) * x(:, 3, 3) - x(:, 1, 3) * x(:, 3, 1)
-    cof(:, 2, 3) = x(:, 1, 2) * x(:, 3, 1) - x(:, 1, 1) * x(:, 3, 2)
-    cof(:, 3, 1) = x(:, 1, 2) * x(:, 2, 3) - x(:, 1, 3) * x(:, 2, 2)
-    cof(:, 3, 2) = x(:, 1, 3) * x(:, 2, 1) - x(:, 1, 1) * x(:, 2, 3)
-    cof(:, 3, 3) = x(:, 1, 1) * x(:, 2, 2) - x(:, 1, 2) * x(:, 2, 1)
-    det = x(:, 1, 1) * cof(:, 1, 1) + x(:, 1, 2) * cof(:, 1, 2) + x(:, 1, 3) * cof(:, 1, 3)
-  end subroutine cofactor
+    do j = 1, 3
+       do i = 1, 3
+          r(e0:e0 + n - 1, i, j) = x(1:n, i, j)
+       end do
+    end do
+  end subroutine polar_rotation_3d_chunk
 
   !> R = I for every element (initial rotation state when the initial configuration is the
   !> reference one).
@@ -239,12 +385,120 @@ contains
 
     if (ndim == 2) then
        call rotate_symmetric_2d(nb, r, transposed, a, b)
+    else if (ndim == 3 .and. ncomp == 6) then
+       call rotate_symmetric_3d(nb, r, transposed, a, b)
     else
        call rotate_symmetric_nd(nb, ndim, ncomp, r, transposed, a, b)
     end if
   end subroutine rotate_symmetric
 
-  !> rotate_symmetric on block temporaries, any ndim (used for 3D).
+  !> rotate_symmetric for ndim = 3 as one element loop on scalars (no block temporaries, one
+  !> pass). The sums are those of rotate_symmetric_nd in the same order, starting from 0 as it
+  !> does, so the result is the same to the bit.
+  pure subroutine rotate_symmetric_3d(nb, r, transposed, a, b)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: r(nb, 3, 3)
+    logical, intent(in) :: transposed
+    real(dp), intent(in) :: a(nb, 6)
+    real(dp), intent(out) :: b(nb, 6)
+    real(dp) :: q11, q12, q13, q21, q22, q23, q31, q32, q33, a1, a2, a3, a4, a5, a6
+    real(dp) :: t11, t12, t13, t21, t22, t23, t31, t32, t33
+    real(dp) :: u11, u12, u13, u21, u22, u23, u31, u32, u33
+    integer :: e
+
+    ! Two loops, the branch outside (inside it would keep the loop scalar).
+    if (transposed) then
+       !GCC$ ivdep
+       do e = 1, nb
+          ! q = Rᵀ
+          q11 = r(e, 1, 1)
+          q12 = r(e, 2, 1)
+          q13 = r(e, 3, 1)
+          q21 = r(e, 1, 2)
+          q22 = r(e, 2, 2)
+          q23 = r(e, 3, 2)
+          q31 = r(e, 1, 3)
+          q32 = r(e, 2, 3)
+          q33 = r(e, 3, 3)
+          a1 = a(e, 1)
+          a2 = a(e, 2)
+          a3 = a(e, 3)
+          a4 = a(e, 4)
+          a5 = a(e, 5)
+          a6 = a(e, 6)
+          t11 = ((0.0_dp + a1 * q11) + a4 * q12) + a6 * q13
+          t21 = ((0.0_dp + a4 * q11) + a2 * q12) + a5 * q13
+          t31 = ((0.0_dp + a6 * q11) + a5 * q12) + a3 * q13
+          t12 = ((0.0_dp + a1 * q21) + a4 * q22) + a6 * q23
+          t22 = ((0.0_dp + a4 * q21) + a2 * q22) + a5 * q23
+          t32 = ((0.0_dp + a6 * q21) + a5 * q22) + a3 * q23
+          t13 = ((0.0_dp + a1 * q31) + a4 * q32) + a6 * q33
+          t23 = ((0.0_dp + a4 * q31) + a2 * q32) + a5 * q33
+          t33 = ((0.0_dp + a6 * q31) + a5 * q32) + a3 * q33
+          u11 = ((0.0_dp + q11 * t11) + q12 * t21) + q13 * t31
+          u21 = ((0.0_dp + q21 * t11) + q22 * t21) + q23 * t31
+          u31 = ((0.0_dp + q31 * t11) + q32 * t21) + q33 * t31
+          u12 = ((0.0_dp + q11 * t12) + q12 * t22) + q13 * t32
+          u22 = ((0.0_dp + q21 * t12) + q22 * t22) + q23 * t32
+          u32 = ((0.0_dp + q31 * t12) + q32 * t22) + q33 * t32
+          u13 = ((0.0_dp + q11 * t13) + q12 * t23) + q13 * t33
+          u23 = ((0.0_dp + q21 * t13) + q22 * t23) + q23 * t33
+          u33 = ((0.0_dp + q31 * t13) + q32 * t23) + q33 * t33
+          b(e, 1) = u11
+          b(e, 2) = u22
+          b(e, 3) = u33
+          b(e, 4) = 0.5_dp * (u12 + u21)
+          b(e, 5) = 0.5_dp * (u23 + u32)
+          b(e, 6) = 0.5_dp * (u31 + u13)
+       end do
+    else
+       !GCC$ ivdep
+       do e = 1, nb
+          ! q = R
+          q11 = r(e, 1, 1)
+          q12 = r(e, 1, 2)
+          q13 = r(e, 1, 3)
+          q21 = r(e, 2, 1)
+          q22 = r(e, 2, 2)
+          q23 = r(e, 2, 3)
+          q31 = r(e, 3, 1)
+          q32 = r(e, 3, 2)
+          q33 = r(e, 3, 3)
+          a1 = a(e, 1)
+          a2 = a(e, 2)
+          a3 = a(e, 3)
+          a4 = a(e, 4)
+          a5 = a(e, 5)
+          a6 = a(e, 6)
+          t11 = ((0.0_dp + a1 * q11) + a4 * q12) + a6 * q13
+          t21 = ((0.0_dp + a4 * q11) + a2 * q12) + a5 * q13
+          t31 = ((0.0_dp + a6 * q11) + a5 * q12) + a3 * q13
+          t12 = ((0.0_dp + a1 * q21) + a4 * q22) + a6 * q23
+          t22 = ((0.0_dp + a4 * q21) + a2 * q22) + a5 * q23
+          t32 = ((0.0_dp + a6 * q21) + a5 * q22) + a3 * q23
+          t13 = ((0.0_dp + a1 * q31) + a4 * q32) + a6 * q33
+          t23 = ((0.0_dp + a4 * q31) + a2 * q32) + a5 * q33
+          t33 = ((0.0_dp + a6 * q31) + a5 * q32) + a3 * q33
+          u11 = ((0.0_dp + q11 * t11) + q12 * t21) + q13 * t31
+          u21 = ((0.0_dp + q21 * t11) + q22 * t21) + q23 * t31
+          u31 = ((0.0_dp + q31 * t11) + q32 * t21) + q33 * t31
+          u12 = ((0.0_dp + q11 * t12) + q12 * t22) + q13 * t32
+          u22 = ((0.0_dp + q21 * t12) + q22 * t22) + q23 * t32
+          u32 = ((0.0_dp + q31 * t12) + q32 * t22) + q33 * t32
+          u13 = ((0.0_dp + q11 * t13) + q12 * t23) + q13 * t33
+          u23 = ((0.0_dp + q21 * t13) + q22 * t23) + q23 * t33
+          u33 = ((0.0_dp + q31 * t13) + q32 * t23) + q33 * t33
+          b(e, 1) = u11
+          b(e, 2) = u22
+          b(e, 3) = u33
+          b(e, 4) = 0.5_dp * (u12 + u21)
+          b(e, 5) = 0.5_dp * (u23 + u32)
+          b(e, 6) = 0.5_dp * (u31 + u13)
+       end do
+    end if
+  end subroutine rotate_symmetric_3d
+
+  !> rotate_symmetric on block temporaries, any ndim (the reference form of the 2D and 3D paths).
   pure subroutine rotate_symmetric_nd(nb, ndim, ncomp, r, transposed, a, b)
     integer, intent(in) :: nb, ndim, ncomp
     real(dp), intent(in) :: r(nb, ndim, ndim)

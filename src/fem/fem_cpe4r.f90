@@ -14,12 +14,12 @@
 !> exactly uniform strain and uniform stress gives self-equilibrated interior forces.
 module fem_cpe4r
   use material_kinds, only: dp
-  use fem_hourglass, only: hourglass_forces
+  use fem_hourglass, only: hourglass_viscous, hourglass_stiffness
   implicit none
   private
 
   public :: cpe4r_geometry, cpe4r_char_length, cpe4r_strain_increment, cpe4r_kinematics
-  public :: cpe4r_internal_force, cpe4r_hourglass_gamma, cpe4r_hourglass
+  public :: cpe4r_internal_force, cpe4r_hourglass_gamma, cpe4r_hourglass, cpe4r_hourglass_update
 
   integer, parameter, public :: cpe4r_ndim = 2, cpe4r_nen = 4, cpe4r_ncomp = 4
   integer, parameter, public :: cpe4r_nshr = 1, cpe4r_nmode = 1
@@ -120,6 +120,9 @@ contains
   !> Everything an increment needs from the geometry, in one call:
   !> mid-increment volume and B (strain, spin, hourglass), end-of-increment volume, B (nodal
   !> forces) and characteristic length (stable increment).
+  !> One element loop doing the work of cpe4r_geometry (twice), cpe4r_strain_increment and
+  !> cpe4r_char_length with their formulas in their order (bitwise the same results): each
+  !> element's coordinates are read once instead of four passes over the block.
   pure subroutine cpe4r_kinematics(nb, thickness, xe_mid, du, xe_new, volume_mid, bmat_mid, &
                                    strain_inc, spin_inc, volume_new, bmat_new, char_length)
     integer, intent(in) :: nb
@@ -128,11 +131,71 @@ contains
     real(dp), intent(out) :: volume_mid(nb), bmat_mid(nb, 2, 4)
     real(dp), intent(out) :: strain_inc(nb, 4), spin_inc(nb, 1)
     real(dp), intent(out) :: volume_new(nb), bmat_new(nb, 2, 4), char_length(nb)
+    real(dp) :: dx, dy, ex, ey, area, r2a, l2max
+    real(dp) :: b11, b12, b13, b14, b21, b22, b23, b24, l11, l12, l21, l22
+    integer :: e
 
-    call cpe4r_geometry(nb, xe_mid, thickness, volume_mid, bmat_mid)
-    call cpe4r_strain_increment(nb, bmat_mid, du, strain_inc, spin_inc)
-    call cpe4r_geometry(nb, xe_new, thickness, volume_new, bmat_new)
-    call cpe4r_char_length(nb, xe_new, char_length)
+    ! ivdep: the dummies do not alias (Fortran), but the compiler's run-time alias checks for
+    ! this many arrays exceed its limit and it left the loop scalar.
+    !GCC$ ivdep
+    do e = 1, nb
+       ! x_{n+½}: volume and B (cpe4r_geometry)
+       dx = xe_mid(e, 1, 3) - xe_mid(e, 1, 1)
+       dy = xe_mid(e, 2, 3) - xe_mid(e, 2, 1)
+       ex = xe_mid(e, 1, 4) - xe_mid(e, 1, 2)
+       ey = xe_mid(e, 2, 4) - xe_mid(e, 2, 2)
+       area = 0.5_dp * (dx * ey - dy * ex)
+       volume_mid(e) = thickness(e) * area
+       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
+       b11 = -ey * r2a
+       b12 = dy * r2a
+       b13 = ey * r2a
+       b14 = -dy * r2a
+       b21 = ex * r2a
+       b22 = -dx * r2a
+       b23 = -ex * r2a
+       b24 = dx * r2a
+       bmat_mid(e, 1, 1) = b11
+       bmat_mid(e, 1, 2) = b12
+       bmat_mid(e, 1, 3) = b13
+       bmat_mid(e, 1, 4) = b14
+       bmat_mid(e, 2, 1) = b21
+       bmat_mid(e, 2, 2) = b22
+       bmat_mid(e, 2, 3) = b23
+       bmat_mid(e, 2, 4) = b24
+       ! strain and spin increments (cpe4r_strain_increment)
+       l11 = (((0.0_dp + du(e, 1, 1) * b11) + du(e, 1, 2) * b12) + du(e, 1, 3) * b13) + du(e, 1, 4) * b14
+       l12 = (((0.0_dp + du(e, 1, 1) * b21) + du(e, 1, 2) * b22) + du(e, 1, 3) * b23) + du(e, 1, 4) * b24
+       l21 = (((0.0_dp + du(e, 2, 1) * b11) + du(e, 2, 2) * b12) + du(e, 2, 3) * b13) + du(e, 2, 4) * b14
+       l22 = (((0.0_dp + du(e, 2, 1) * b21) + du(e, 2, 2) * b22) + du(e, 2, 3) * b23) + du(e, 2, 4) * b24
+       strain_inc(e, 1) = l11
+       strain_inc(e, 2) = l22
+       strain_inc(e, 3) = 0.0_dp
+       strain_inc(e, 4) = 0.5_dp * (l12 + l21)
+       spin_inc(e, 1) = 0.5_dp * (l21 - l12)
+       ! x_{n+1}: volume and B (cpe4r_geometry) and L_e (cpe4r_char_length, whose area is the
+       ! same expression as here)
+       dx = xe_new(e, 1, 3) - xe_new(e, 1, 1)
+       dy = xe_new(e, 2, 3) - xe_new(e, 2, 1)
+       ex = xe_new(e, 1, 4) - xe_new(e, 1, 2)
+       ey = xe_new(e, 2, 4) - xe_new(e, 2, 2)
+       area = 0.5_dp * (dx * ey - dy * ex)
+       volume_new(e) = thickness(e) * area
+       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
+       bmat_new(e, 1, 1) = -ey * r2a
+       bmat_new(e, 1, 2) = dy * r2a
+       bmat_new(e, 1, 3) = ey * r2a
+       bmat_new(e, 1, 4) = -dy * r2a
+       bmat_new(e, 2, 1) = ex * r2a
+       bmat_new(e, 2, 2) = -dx * r2a
+       bmat_new(e, 2, 3) = -ex * r2a
+       bmat_new(e, 2, 4) = dx * r2a
+       l2max = max((xe_new(e, 1, 2) - xe_new(e, 1, 1))**2 + (xe_new(e, 2, 2) - xe_new(e, 2, 1))**2, &
+                   (xe_new(e, 1, 3) - xe_new(e, 1, 2))**2 + (xe_new(e, 2, 3) - xe_new(e, 2, 2))**2, &
+                   (xe_new(e, 1, 4) - xe_new(e, 1, 3))**2 + (xe_new(e, 2, 4) - xe_new(e, 2, 3))**2, &
+                   (xe_new(e, 1, 1) - xe_new(e, 1, 4))**2 + (xe_new(e, 2, 1) - xe_new(e, 2, 4))**2)
+       char_length(e) = abs(area) / sqrt(max(l2max, tiny(1.0_dp)))
+    end do
   end subroutine cpe4r_kinematics
 
   !> f_iI = V Σ_j σ_ij B_jI with the global stress (σ33 does no work in plane strain).
@@ -179,6 +242,8 @@ contains
   !> density ρ and p-wave modulus λ+2μ per element. hg_state (nb, 2, 1): corotational
   !> hourglass generalised force of the stiffness form (zero it at the start; untouched by
   !> the viscous form). rot_mid, rot_new: R_{n+½}, R_{n+1} (fem_corotation).
+  !> energy_inc is the kernel's own increment (C q²/Δt, resp. ½ (Q^c_old + Q^c_new)·qc); the
+  !> solver books the trapezoidal work of cpe4r_hourglass_update instead.
   pure subroutine cpe4r_hourglass(nb, thickness, xe_mid, volume_mid, bmat_mid, du, dt, density, &
                                   modulus, kind, coefficient, rot_mid, rot_new, hg_state, fe, &
                                   energy_inc)
@@ -193,22 +258,141 @@ contains
     real(dp), intent(inout) :: hg_state(nb, 2, 1)
     real(dp), intent(inout) :: fe(nb, 2, 4)
     real(dp), intent(out) :: energy_inc(nb)
-    real(dp) :: gamma(nb, 4, 1), visc(nb), stiff(nb), area(nb)
-    integer :: i, n
+    real(dp), allocatable :: force_hg(:, :, :), work(:)
 
-    call cpe4r_hourglass_gamma(nb, xe_mid, bmat_mid, gamma)
-    area = abs(volume_mid) / thickness
-    ! ρ c_d = sqrt(ρ (λ+2μ))
-    visc = 0.25_dp * sqrt(density * modulus) * thickness * sqrt(area)
-    ! Σ_iI B_iI² accumulated in place (a sum(sum(B**2)) expression would build a block temporary)
-    stiff = 0.0_dp
-    do n = 1, 4
-       do i = 1, 2
-          stiff = stiff + bmat_mid(:, i, n)**2
-       end do
-    end do
-    stiff = 0.25_dp * modulus * volume_mid * stiff
-    call hourglass_forces(nb, 2, 4, 1, gamma, du, dt, kind, coefficient, visc, stiff, &
-                          rot_mid, rot_new, hg_state, fe, energy_inc)
+    ! Not on the solver's path (tests, single elements): the extra arrays may be allocated.
+    allocate(force_hg(nb, 2, 4), work(nb))
+    force_hg = 0.0_dp
+    call cpe4r_hourglass_update(nb, thickness, xe_mid, volume_mid, bmat_mid, du, dt, density, &
+         modulus, kind, coefficient, rot_mid, rot_new, hg_state, fe, force_hg, energy_inc, work)
   end subroutine cpe4r_hourglass
+
+  !> cpe4r_hourglass as the solver uses it: one element loop on scalars (no block temporaries,
+  !> every element read once), which also books the hourglass work.
+  !> force_hg (nb, 2, 4): in, the hourglass forces of the element at t_n; out, those at t_{n+1},
+  !> taken as the change of fe they make (fe_after − fe_before: the forces the assembly sees).
+  !> work (nb): ½ Σ_iI (f_n + f_{n+1})_iI du_iI, the trapezoidal work of the hourglass forces
+  !> over the increment, as the energy balance charges it (ALLAE).
+  !> The sums and their order are those of cpe4r_hourglass_gamma, fem_hourglass's
+  !> hourglass_forces and the driver's former separate work loop, so results are bitwise the same.
+  pure subroutine cpe4r_hourglass_update(nb, thickness, xe_mid, volume_mid, bmat_mid, du, dt, &
+                                         density, modulus, kind, coefficient, rot_mid, rot_new, &
+                                         hg_state, fe, force_hg, energy_inc, work)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: thickness(nb)
+    real(dp), intent(in) :: xe_mid(nb, 2, 4), volume_mid(nb), bmat_mid(nb, 2, 4)
+    real(dp), intent(in) :: du(nb, 2, 4), dt
+    real(dp), intent(in) :: density(nb), modulus(nb)
+    integer, intent(in) :: kind
+    real(dp), intent(in) :: coefficient
+    real(dp), intent(in) :: rot_mid(nb, 2, 2), rot_new(nb, 2, 2)
+    real(dp), intent(inout) :: hg_state(nb, 2, 1)
+    real(dp), intent(inout) :: fe(nb, 2, 4), force_hg(nb, 2, 4)
+    real(dp), intent(out) :: energy_inc(nb), work(nb)
+    real(dp) :: hx, hy, g1, g2, g3, g4, q1, q2, qc1, qc2, h1, h2, qg1, qg2, area, scale, c, dtm
+    real(dp) :: f_old, f_new, df, w
+    integer :: e
+
+    dtm = max(dt, tiny(1.0_dp))
+    if (kind == hourglass_viscous) then
+       ! The usual form, on its own loop: without the branch on kind it vectorises. (The
+       ! dummies cannot alias, which ivdep tells the compiler: its run-time alias checks for
+       ! this many arrays exceed its limit, and it then left the loop scalar.)
+       !GCC$ ivdep
+       do e = 1, nb
+          ! γ_I = h_I − (h·x) B_xI − (h·y) B_yI (cpe4r_hourglass_gamma)
+          hx = xe_mid(e, 1, 1) - xe_mid(e, 1, 2) + xe_mid(e, 1, 3) - xe_mid(e, 1, 4)
+          hy = xe_mid(e, 2, 1) - xe_mid(e, 2, 2) + xe_mid(e, 2, 3) - xe_mid(e, 2, 4)
+          g1 = hg_base(1) - hx * bmat_mid(e, 1, 1) - hy * bmat_mid(e, 2, 1)
+          g2 = hg_base(2) - hx * bmat_mid(e, 1, 2) - hy * bmat_mid(e, 2, 2)
+          g3 = hg_base(3) - hx * bmat_mid(e, 1, 3) - hy * bmat_mid(e, 2, 3)
+          g4 = hg_base(4) - hx * bmat_mid(e, 1, 4) - hy * bmat_mid(e, 2, 4)
+          ! q_i = Σ_I γ_I du_iI
+          q1 = (((0.0_dp + g1 * du(e, 1, 1)) + g2 * du(e, 1, 2)) + g3 * du(e, 1, 3)) + g4 * du(e, 1, 4)
+          q2 = (((0.0_dp + g1 * du(e, 2, 1)) + g2 * du(e, 2, 2)) + g3 * du(e, 2, 3)) + g4 * du(e, 2, 4)
+          ! generalised force C q/Δt and energy C q²/Δt
+          area = abs(volume_mid(e)) / thickness(e)
+          scale = 0.25_dp * sqrt(density(e) * modulus(e)) * thickness(e) * sqrt(area)
+          c = coefficient * scale / dtm
+          qg1 = c * q1
+          qg2 = c * q2
+          energy_inc(e) = (0.0_dp + qg1 * q1) + qg2 * q2
+          ! f_iI += qg_i γ_I; the force change and its trapezoidal work, node by node, i inner
+          w = 0.0_dp
+          f_old = fe(e, 1, 1); f_new = f_old + qg1 * g1; fe(e, 1, 1) = f_new; df = f_new - f_old
+          w = w + 0.5_dp * (force_hg(e, 1, 1) + df) * du(e, 1, 1); force_hg(e, 1, 1) = df
+          f_old = fe(e, 2, 1); f_new = f_old + qg2 * g1; fe(e, 2, 1) = f_new; df = f_new - f_old
+          w = w + 0.5_dp * (force_hg(e, 2, 1) + df) * du(e, 2, 1); force_hg(e, 2, 1) = df
+          f_old = fe(e, 1, 2); f_new = f_old + qg1 * g2; fe(e, 1, 2) = f_new; df = f_new - f_old
+          w = w + 0.5_dp * (force_hg(e, 1, 2) + df) * du(e, 1, 2); force_hg(e, 1, 2) = df
+          f_old = fe(e, 2, 2); f_new = f_old + qg2 * g2; fe(e, 2, 2) = f_new; df = f_new - f_old
+          w = w + 0.5_dp * (force_hg(e, 2, 2) + df) * du(e, 2, 2); force_hg(e, 2, 2) = df
+          f_old = fe(e, 1, 3); f_new = f_old + qg1 * g3; fe(e, 1, 3) = f_new; df = f_new - f_old
+          w = w + 0.5_dp * (force_hg(e, 1, 3) + df) * du(e, 1, 3); force_hg(e, 1, 3) = df
+          f_old = fe(e, 2, 3); f_new = f_old + qg2 * g3; fe(e, 2, 3) = f_new; df = f_new - f_old
+          w = w + 0.5_dp * (force_hg(e, 2, 3) + df) * du(e, 2, 3); force_hg(e, 2, 3) = df
+          f_old = fe(e, 1, 4); f_new = f_old + qg1 * g4; fe(e, 1, 4) = f_new; df = f_new - f_old
+          w = w + 0.5_dp * (force_hg(e, 1, 4) + df) * du(e, 1, 4); force_hg(e, 1, 4) = df
+          f_old = fe(e, 2, 4); f_new = f_old + qg2 * g4; fe(e, 2, 4) = f_new; df = f_new - f_old
+          w = w + 0.5_dp * (force_hg(e, 2, 4) + df) * du(e, 2, 4); force_hg(e, 2, 4) = df
+          work(e) = w
+       end do
+       return
+    end if
+
+    ! Stiffness form, or none: the same steps with the generalised force of that form.
+    do e = 1, nb
+       hx = xe_mid(e, 1, 1) - xe_mid(e, 1, 2) + xe_mid(e, 1, 3) - xe_mid(e, 1, 4)
+       hy = xe_mid(e, 2, 1) - xe_mid(e, 2, 2) + xe_mid(e, 2, 3) - xe_mid(e, 2, 4)
+       g1 = hg_base(1) - hx * bmat_mid(e, 1, 1) - hy * bmat_mid(e, 2, 1)
+       g2 = hg_base(2) - hx * bmat_mid(e, 1, 2) - hy * bmat_mid(e, 2, 2)
+       g3 = hg_base(3) - hx * bmat_mid(e, 1, 3) - hy * bmat_mid(e, 2, 3)
+       g4 = hg_base(4) - hx * bmat_mid(e, 1, 4) - hy * bmat_mid(e, 2, 4)
+       q1 = (((0.0_dp + g1 * du(e, 1, 1)) + g2 * du(e, 1, 2)) + g3 * du(e, 1, 3)) + g4 * du(e, 1, 4)
+       q2 = (((0.0_dp + g1 * du(e, 2, 1)) + g2 * du(e, 2, 2)) + g3 * du(e, 2, 3)) + g4 * du(e, 2, 4)
+       if (kind == hourglass_stiffness) then
+          ! Σ_iI B_iI² in the order of the node loop
+          scale = ((((((((0.0_dp + bmat_mid(e, 1, 1)**2) + bmat_mid(e, 2, 1)**2) + bmat_mid(e, 1, 2)**2) &
+               + bmat_mid(e, 2, 2)**2) + bmat_mid(e, 1, 3)**2) + bmat_mid(e, 2, 3)**2) &
+               + bmat_mid(e, 1, 4)**2) + bmat_mid(e, 2, 4)**2)
+          scale = 0.25_dp * modulus(e) * volume_mid(e) * scale
+          c = coefficient * scale
+          ! qc = R_{n+½}ᵀ q; Q^c += K qc; qg = R_{n+1} Q^c
+          qc1 = (0.0_dp + rot_mid(e, 1, 1) * q1) + rot_mid(e, 2, 1) * q2
+          qc2 = (0.0_dp + rot_mid(e, 1, 2) * q1) + rot_mid(e, 2, 2) * q2
+          h1 = hg_state(e, 1, 1)
+          h2 = hg_state(e, 2, 1)
+          energy_inc(e) = (0.0_dp + (h1 + 0.5_dp * c * qc1) * qc1) + (h2 + 0.5_dp * c * qc2) * qc2
+          h1 = h1 + c * qc1
+          h2 = h2 + c * qc2
+          hg_state(e, 1, 1) = h1
+          hg_state(e, 2, 1) = h2
+          qg1 = (0.0_dp + rot_new(e, 1, 1) * h1) + rot_new(e, 1, 2) * h2
+          qg2 = (0.0_dp + rot_new(e, 2, 1) * h1) + rot_new(e, 2, 2) * h2
+       else
+          ! no hourglass control: no force (fe + 0 = fe below), no energy
+          qg1 = 0.0_dp
+          qg2 = 0.0_dp
+          energy_inc(e) = 0.0_dp
+       end if
+       w = 0.0_dp
+       f_old = fe(e, 1, 1); f_new = f_old + qg1 * g1; fe(e, 1, 1) = f_new; df = f_new - f_old
+       w = w + 0.5_dp * (force_hg(e, 1, 1) + df) * du(e, 1, 1); force_hg(e, 1, 1) = df
+       f_old = fe(e, 2, 1); f_new = f_old + qg2 * g1; fe(e, 2, 1) = f_new; df = f_new - f_old
+       w = w + 0.5_dp * (force_hg(e, 2, 1) + df) * du(e, 2, 1); force_hg(e, 2, 1) = df
+       f_old = fe(e, 1, 2); f_new = f_old + qg1 * g2; fe(e, 1, 2) = f_new; df = f_new - f_old
+       w = w + 0.5_dp * (force_hg(e, 1, 2) + df) * du(e, 1, 2); force_hg(e, 1, 2) = df
+       f_old = fe(e, 2, 2); f_new = f_old + qg2 * g2; fe(e, 2, 2) = f_new; df = f_new - f_old
+       w = w + 0.5_dp * (force_hg(e, 2, 2) + df) * du(e, 2, 2); force_hg(e, 2, 2) = df
+       f_old = fe(e, 1, 3); f_new = f_old + qg1 * g3; fe(e, 1, 3) = f_new; df = f_new - f_old
+       w = w + 0.5_dp * (force_hg(e, 1, 3) + df) * du(e, 1, 3); force_hg(e, 1, 3) = df
+       f_old = fe(e, 2, 3); f_new = f_old + qg2 * g3; fe(e, 2, 3) = f_new; df = f_new - f_old
+       w = w + 0.5_dp * (force_hg(e, 2, 3) + df) * du(e, 2, 3); force_hg(e, 2, 3) = df
+       f_old = fe(e, 1, 4); f_new = f_old + qg1 * g4; fe(e, 1, 4) = f_new; df = f_new - f_old
+       w = w + 0.5_dp * (force_hg(e, 1, 4) + df) * du(e, 1, 4); force_hg(e, 1, 4) = df
+       f_old = fe(e, 2, 4); f_new = f_old + qg2 * g4; fe(e, 2, 4) = f_new; df = f_new - f_old
+       w = w + 0.5_dp * (force_hg(e, 2, 4) + df) * du(e, 2, 4); force_hg(e, 2, 4) = df
+       work(e) = w
+    end do
+  end subroutine cpe4r_hourglass_update
 end module fem_cpe4r

@@ -45,13 +45,14 @@ contains
     real(dp), intent(in) :: volume(nb), volume_ref(nb)
     real(dp), intent(in) :: min_volume_ratio
     integer, intent(out) :: reason(nb)
-    real(dp) :: jmin(nb)
+    real(dp), allocatable :: jmin(:)
 
     if (ndim == 2) then
-       call min_corner_jacobian_2d(nb, xe, jmin)
-    else
-       call min_corner_jacobian_3d(nb, xe, jmin)
+       call check_inversion_2d(nb, xe, volume, volume_ref, min_volume_ratio, reason)
+       return
     end if
+    allocate(jmin(nb))
+    call min_corner_jacobian_3d(nb, xe, jmin)
     reason = merge(inversion_centre, &
                    merge(inversion_corner, &
                          merge(inversion_collapse, inversion_none, &
@@ -60,26 +61,37 @@ contains
                    volume <= 0.0_dp)
   end subroutine check_inversion
 
-  !> Smallest corner value ξ_I η_I · (x_nξ − x_I) × (x_nη − x_I) (4 × the corner Jacobian).
-  pure subroutine min_corner_jacobian_2d(nb, xe, jmin)
+  !> check_inversion for CPE4R as one element loop on scalars (no block-sized temporary, which
+  !> gfortran would allocate on the heap at every call). Corner values ξ_I η_I ·
+  !> (x_nξ − x_I) × (x_nη − x_I) (4 × the corner Jacobian), their minimum, then the tests in the
+  !> order of the 3D path.
+  pure subroutine check_inversion_2d(nb, xe, volume, volume_ref, min_volume_ratio, reason)
     integer, intent(in) :: nb
     real(dp), intent(in) :: xe(nb, 2, 4)
-    real(dp), intent(out) :: jmin(nb)
-    integer :: n, a, b, e
-    real(dp) :: s, j
+    real(dp), intent(in) :: volume(nb), volume_ref(nb)
+    real(dp), intent(in) :: min_volume_ratio
+    integer, intent(out) :: reason(nb)
+    integer :: n, a, b, e, r
+    real(dp) :: s, j, jmin
 
-    jmin = huge(1.0_dp)
-    do n = 1, 4
-       a = nxi2(n)
-       b = neta2(n)
-       s = xi2(n) * eta2(n)
-       do e = 1, nb
+    !GCC$ ivdep
+    do e = 1, nb
+       jmin = huge(1.0_dp)
+       do n = 1, 4
+          a = nxi2(n)
+          b = neta2(n)
+          s = xi2(n) * eta2(n)
           j = s * ((xe(e, 1, a) - xe(e, 1, n)) * (xe(e, 2, b) - xe(e, 2, n)) &
                    - (xe(e, 2, a) - xe(e, 2, n)) * (xe(e, 1, b) - xe(e, 1, n)))
-          jmin(e) = min(jmin(e), j)
+          jmin = min(jmin, j)
        end do
+       r = inversion_none
+       if (volume(e) < min_volume_ratio * volume_ref(e)) r = inversion_collapse
+       if (jmin <= 0.0_dp) r = inversion_corner
+       if (volume(e) <= 0.0_dp) r = inversion_centre
+       reason(e) = r
     end do
-  end subroutine min_corner_jacobian_2d
+  end subroutine check_inversion_2d
 
   !> Smallest corner value −ξ_I η_I ζ_I · det[x_nξ − x_I, x_nη − x_I, x_nζ − x_I]
   !> (8 × the corner Jacobian of the trilinear map).
