@@ -114,11 +114,29 @@ if [ ! -x "$venv/bin/python" ] || [ "$(readlink -f "$venv_home")" != "$(dirname 
   quietly "$base" -m venv --system-site-packages "$venv"
 fi
 
-# The bulkflow Python package, editable; re-installed when its pyproject.toml changes.
+# The bulkflow Python package, editable; re-installed when its pyproject.toml changes, when a
+# console script it declares is missing from .venv/bin, or when `import bulkflow` does not come
+# from this checkout (e.g. a .venv copied from another worktree).
+editable_install_stale() {
+  "$venv/bin/python" - "$repo/scripts" "$venv/bin" <<'PY'
+import pathlib, re, sys
+scripts, bindir = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+text = (scripts / "pyproject.toml").read_text()
+section = re.search(r"^\[project\.scripts\]\s*$(.*?)(?=^\[|\Z)", text, re.M | re.S)
+names = re.findall(r"^\s*([A-Za-z0-9_.-]+)\s*=", section.group(1), re.M) if section else []
+missing = [n for n in names if not (bindir / n).exists()]
+try:
+    import bulkflow
+    here = pathlib.Path(bulkflow.__file__).resolve().parent == (scripts / "bulkflow").resolve()
+except Exception:
+    here = False
+sys.exit(0 if missing or not here else 1)
+PY
+}
 if [ -f "$repo/scripts/pyproject.toml" ]; then
   stamp="$venv/.bulkflow-pyproject.sha256"
   wanted=$(sha256sum "$repo/scripts/pyproject.toml" | cut -d' ' -f1)
-  if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$wanted" ]; then
+  if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$wanted" ] || editable_install_stale; then
     echo "setup.sh: pip install -e scripts/ (into $venv)"
     quietly "$venv/bin/python" -m pip install --quiet --disable-pip-version-check -e "$repo/scripts"
     echo "$wanted" >"$stamp"
