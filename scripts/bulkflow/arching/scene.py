@@ -43,41 +43,40 @@ from pathlib import Path
 
 import numpy as np
 
+from bulkflow.theory import Hopper, Material, enstad_outlet_arch
+from bulkflow.theory.cases import CASES, READINGS
+from bulkflow.theory.cases import case as theory_case
+from bulkflow.theory.mohr import fc_from_c
+
 G = 9.81
 
 
 def fc0_from_c0(c0: float, phi_deg: float) -> float:
     """Thesis eq. 6.9 at zero consolidation: fc0 = 2 c0 cos φ / (1 − sin φ)."""
-    p = math.radians(phi_deg)
-    return 2.0 * c0 * math.cos(p) / (1.0 - math.sin(p))
+    return float(fc_from_c(c0, phi_deg))
 
 
-#: Thesis Table 6.1 (Cases A, B) and Table 6.2 (Eckhoff & Leversen powders). `c0` is what the
-#: tables print as "cohesion at zero consolidation stress". E, ν: thesis §6.2 (10 MPa, 0.2).
-#: The powders' material height is not reported; 1 m is our choice (hopper_theory.md §i.4 item 5).
-CASES = {
-    "A": dict(rho=400.0, theta=30.0, phi=40.0, phi_w=20.0, k=0.2, c0=350.0, height=2.0),
-    "B": dict(rho=400.0, theta=30.0, phi=20.0, phi_w=0.0, k=0.0, c0=800.0, height=2.0),
-    "polymer": dict(rho=440.0, theta=14.5, phi=34.0, phi_w=26.0, k=0.62, c0=519.0, height=1.0),
-    "sic": dict(rho=900.0, theta=16.0, phi=28.6, phi_w=33.3, k=0.47, c0=175.0, height=1.0),
-}
-
-#: How the tabulated cohesion value is turned into fc0 (issue 4 part 3, hopper_theory.md §0.4):
-#: "c0": it is the cohesion c0 and eq. 6.9 gives fc0 (as the thesis documents);
-#: "fc0": it is fc0 itself (what the thesis's own polymer theory numbers imply).
-READINGS = ("c0", "fc0")
+#: The named cases are the theory package's (thesis Tables 6.1, 6.2: bulkflow.theory.cases), so
+#: scenes and estimates share one source. How the tabulated cohesion becomes fc0 (issue 4 part 3,
+#: hopper_theory.md §0.4): "c0" — it is c0 and eq. 6.9 gives fc0 (as the thesis documents); "fc0" —
+#: it is fc0 itself (what the thesis's own polymer theory numbers imply). Cases A and B offer "c0"
+#: only. The powders' fill height is not reported; the theory's EL_HEIGHT (1 m above the apex).
+CASE_NAMES = tuple(CASES)
 
 
 def case_material(case: str, reading: str = "c0") -> dict:
     """rho, phi, phi_w, k, fc0, theta, height of a named case under a c0 reading."""
-    if case not in CASES:
-        raise ValueError(f"unknown case {case!r}; expected one of {sorted(CASES)}")
-    if reading not in READINGS:
-        raise ValueError(f"unknown reading {reading!r}; expected one of {READINGS}")
-    d = dict(CASES[case])
-    c0 = d.pop("c0")
-    d["fc0"] = fc0_from_c0(c0, d["phi"]) if reading == "c0" else c0
-    return d
+    c = theory_case(case)
+    return dict(rho=c.rho, theta=c.theta_deg, phi=c.phi_deg, phi_w=c.phi_w_deg, k=c.k,
+                fc0=float(c.fc0(reading)), height=c.height)
+
+
+def enstad_beta(case_or_params: dict) -> float:
+    """Enstad's arch angle β (deg) for the material/hopper of `case_material`-like parameters."""
+    m = Material(rho=case_or_params["rho"], phi_deg=case_or_params["phi"], phi_w_deg=case_or_params["phi_w"],
+                 k=case_or_params["k"], fc0=case_or_params["fc0"])
+    h = Hopper(theta_deg=case_or_params["theta"], height=case_or_params["height"])
+    return float(enstad_outlet_arch(h, m, 0.1)["beta_deg"])
 
 
 @dataclass
@@ -335,14 +334,15 @@ def scene_from_case(case: str, reading: str = "c0", **overrides) -> ArchingScene
 def add_scene_arguments(p: argparse.ArgumentParser) -> None:
     """Options shared by bulkflow-make-arching and bulkflow-cow."""
     d = ArchingScene()
-    p.add_argument("--case", choices=sorted(CASES), help="named parameter set (thesis Tables 6.1, 6.2)")
+    p.add_argument("--case", choices=CASE_NAMES, help="named parameter set (thesis Tables 6.1, 6.2)")
     p.add_argument("--reading", choices=READINGS, default="c0",
                    help="how the tabulated cohesion value becomes fc0: c0 (eq. 6.9) or fc0 (taken as is)")
     g = p.add_argument_group("geometry and mesh (override the case)")
     g.add_argument("--theta", type=float)
     g.add_argument("--height", type=float, help="top surface height above the apex (m)")
     g.add_argument("--arch", choices=["apex", "enstad"], default=d.arch)
-    g.add_argument("--beta", type=float, default=None, help="Enstad arch angle (deg); default: 45 - theta/2 capped by the case")
+    g.add_argument("--beta", type=float, default=None,
+                   help="Enstad arch angle (deg); default: the theory's (bulkflow.theory.enstad_outlet_arch)")
     g.add_argument("--n-arc", type=int, default=d.n_arc, help="elements along the outlet arc")
     g = p.add_argument_group("material (override the case)")
     g.add_argument("--density", type=float)
@@ -387,8 +387,13 @@ def scene_from_args(a, outlet_width: float | None = None) -> ArchingScene:
         table = tuple(tuple(float(v) for v in pair.split(":")) for pair in a.table.split(","))
     beta = a.beta
     if beta is None:
-        th = base.get("theta", ArchingScene.theta)
-        beta = min(base.get("phi_w", 0.0), 45.0 - th / 2.0) if a.arch == "enstad" else 0.0
+        beta = 0.0
+        if a.arch == "enstad":
+            d = ArchingScene()
+            beta = enstad_beta(dict(rho=base.get("density", d.density), phi=base.get("phi", d.phi),
+                                    phi_w=base.get("phi_w", d.phi_w), k=base.get("k", d.k),
+                                    fc0=base.get("fc0", d.fc0), theta=base.get("theta", d.theta),
+                                    height=base.get("height", d.height)))
     s = ArchingScene(**base, arch=a.arch, beta=beta, n_arc=a.n_arc, young=a.young, poisson=a.poisson,
                      flow=a.flow, table=table, state=a.state, t_gravity=a.t_gravity, t_slide=a.t_slide,
                      slide=a.slide, t_open=a.t_open, mass_scaling_dt_factor=a.mass_scaling,
