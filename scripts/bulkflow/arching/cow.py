@@ -56,8 +56,8 @@ class Search:
         self.known: dict[tuple, bool] = {}     # (width rounded to 1 µm, n_arc) -> flows
 
     def max_width(self) -> float:
-        # the outlet must stay well below the top surface
-        return 2.0 * 0.6 * self.scene.height * math.tan(math.radians(self.scene.theta))
+        # the outlet crown (r_out on the axis) must stay below the top surface: r_out <= 0.85 H
+        return 2.0 * 0.85 * self.scene.height * math.sin(math.radians(self.scene.theta))
 
     def trial(self, width: float, n_arc: int) -> bool:
         key = (round(width, 6), n_arc)
