@@ -2,7 +2,7 @@
 """Arching scene tests (issue 4): the generator's scene runs, and the flow/no-flow decision is right.
 
     check_arching.py decide  --bulkflow BIN --workdir DIR
-    check_arching.py mpi     --bulkflow BIN --workdir DIR --mpiexec MPIEXEC [--mpiexec-flag F] --ranks 1 2 3
+    check_arching.py mpi     --bulkflow BIN --workdir DIR --mpiexec MPIEXEC [--mpiexec-flag F] --ranks 1 3
     check_arching.py restart --bulkflow BIN --workdir DIR --stop-after N [--ranks R --mpiexec ...]
 
 Scenes: Case B (thesis Table 6.1, fc0 = 2285 Pa) at H = 1 m above the apex on a coarse mesh

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import re
+import resource
 import shutil
 import subprocess
 import time
@@ -49,6 +50,8 @@ class RunRecord:
     flows: bool                       #: FLOW or UNDECIDED (the material is not at rest)
     wall: float                       #: wall-clock seconds of the solver run
     increments: int
+    cpu: float = 0.0                  #: CPU seconds of the run, all ranks (the machine may be shared)
+    element_steps: int = 0            #: increments × elements: the work, independent of the load
     decision: dict = field(default_factory=dict)
     solver_line: str = ""
     base: str = ""
@@ -74,8 +77,11 @@ def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = No
         mpirun = shutil.which("mpirun") or "mpirun"
         cmd = [mpirun, "-np", str(np)] + cmd
     t0 = time.perf_counter()
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     proc = subprocess.run(cmd, capture_output=True, text=True, env=mpi_environment())
     wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
     (workdir / f"{name}.log").write_text(proc.stdout + proc.stderr)
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed with status {proc.returncode}:\n{proc.stderr[-2000:]}")
@@ -86,7 +92,8 @@ def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = No
     rec = RunRecord(outlet_width=scene.outlet_width, n_arc=scene.n_arc, n_elements=scene.n_elements(),
                     outcome=d.outcome, flows=d.outcome in (FLOW, UNDECIDED), wall=wall,
                     increments=int(m.group(1)) if m else 0, decision=d.as_dict(), solver_line=line,
-                    base=str(base))
+                    base=str(base), cpu=cpu)
+    rec.element_steps = rec.increments * rec.n_elements
     if not keep:
         for suffix in (".h5", ".xmf"):
             p = Path(f"{base}{suffix}")
@@ -94,5 +101,5 @@ def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = No
                 p.unlink()
     if log:
         log(f"  B = {scene.outlet_width * 100:7.3f} cm  n_arc {scene.n_arc:3d} ({rec.n_elements} el): "
-            f"{d.summary()}  [{wall:.1f} s, {rec.increments} inc]")
+            f"{d.summary()}  [{wall:.1f} s wall, {cpu:.1f} s cpu, {rec.increments} inc]")
     return rec
