@@ -9,7 +9,7 @@ module driver_checkpoint
        checkpoint_end_write, checkpoint_begin_read, checkpoint_get, checkpoint_end_read
   use output_hdf5, only: field_writer_frame_count
   use output_history, only: history_row_count
-  use driver_solver, only: solver_t
+  use driver_solver, only: solver_t, element_block_t
   use driver_output, only: run_output_t
   implicit none
   private
@@ -48,6 +48,16 @@ contains
          solver%e_external, solver%step_start, solver%dt_prev, solver%dt_stable, out%next_field, &
          out%next_history, out%energy_reference, out%energy_peak])
     call checkpoint_put(ck, 'counters', [solver%step_increment, solver%dt_element])
+    ! Mass scaling and the step stop condition (driver_mass_scaling, driver_stop_condition).
+    call checkpoint_put(ck, 'mass', solver%mass)
+    if (allocated(solver%u_step_start)) then
+       call checkpoint_put(ck, 'u_step_start', solver%u_step_start)
+    else
+       call checkpoint_put(ck, 'u_step_start', solver%u)
+    end if
+    call checkpoint_put(ck, 'stop_scalars', [solver%stop_umax, solver%stop_ke, solver%stop_ke_peak, &
+         solver%stop_quiet_since, solver%stop_window_start, solver%stop_window_umax])
+    call checkpoint_put(ck, 'stop_outcome', solver%stop_outcome)
     do ib = 1, solver%n_blocks
        write (tag, '(a,i0,a)') 'b', ib, '_'
        associate (b => solver%blocks(ib))
@@ -62,6 +72,7 @@ contains
          call checkpoint_put(ck, trim(tag) // 'log_strain', b%log_strain)
          call checkpoint_put(ck, trim(tag) // 'sigma_bv', b%sigma_bv)
          call checkpoint_put(ck, trim(tag) // 'force_hg', b%force_hg)
+         call checkpoint_put(ck, trim(tag) // 'mass_scale', block_mass_scale(b))
        end associate
     end do
     call checkpoint_end_write(ck)
@@ -78,6 +89,7 @@ contains
     real(dp) :: scalars(11)
     real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
     integer :: counters(2), ib, i
+    real(dp) :: stop_scalars(6)
     character(len=16) :: tag
 
     call checkpoint_begin_read(ck, base, solver%part%comm, header)
@@ -113,6 +125,17 @@ contains
     call checkpoint_get(ck, 'counters', counters)
     solver%step_increment = counters(1)
     solver%dt_element = counters(2)
+    call checkpoint_get(ck, 'mass', solver%mass)
+    if (.not. allocated(solver%u_step_start)) allocate(solver%u_step_start, mold=solver%u)
+    call checkpoint_get(ck, 'u_step_start', solver%u_step_start)
+    call checkpoint_get(ck, 'stop_scalars', stop_scalars)
+    solver%stop_umax = stop_scalars(1)
+    solver%stop_ke = stop_scalars(2)
+    solver%stop_ke_peak = stop_scalars(3)
+    solver%stop_quiet_since = stop_scalars(4)
+    solver%stop_window_start = stop_scalars(5)
+    solver%stop_window_umax = stop_scalars(6)
+    call checkpoint_get(ck, 'stop_outcome', solver%stop_outcome)
     do ib = 1, solver%n_blocks
        write (tag, '(a,i0,a)') 'b', ib, '_'
        associate (b => solver%blocks(ib))
@@ -127,6 +150,9 @@ contains
          call checkpoint_get(ck, trim(tag) // 'log_strain', b%log_strain)
          call checkpoint_get(ck, trim(tag) // 'sigma_bv', b%sigma_bv)
          call checkpoint_get(ck, trim(tag) // 'force_hg', b%force_hg)
+         if (.not. allocated(b%mass_scale)) allocate(b%mass_scale(b%count))
+         call checkpoint_get(ck, trim(tag) // 'mass_scale', b%mass_scale)
+         b%mass_scaled = maxval(abs(b%mass_scale - 1)) > 0
        end associate
     end do
     call checkpoint_end_read(ck)
@@ -135,6 +161,15 @@ contains
     solver%restart_energy_reference = scalars(10)
     solver%restart_energy_peak = scalars(11)
   end subroutine load_checkpoint
+
+  !> The block's mass-scaling factors (ones before any scaling).
+  function block_mass_scale(b) result(values)
+    type(element_block_t), intent(in) :: b
+    real(dp) :: values(b%count)
+
+    values = 1
+    if (allocated(b%mass_scale)) values = b%mass_scale
+  end function block_mass_scale
 
   function rigid_array(solver, displacement) result(values)
     type(solver_t), intent(in) :: solver

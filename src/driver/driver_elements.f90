@@ -285,6 +285,9 @@ contains
     blk%rotation = w%r_new(1:nb, :, :)
     call to_global(nb, nd, nc, blk%rotation, blk%stress, blk%stress_global)
 
+    ! Mass scaling (driver_mass_scaling): wave speed, stable increment, bulk viscosity and
+    ! hourglass see the scaled inertia; the VUMAT above got the physical density.
+    if (blk%mass_scaled) w%density(1:nb) = w%density(1:nb) * blk%mass_scale
     w%wave_speed(1:nb) = sqrt(blk%wave_modulus / w%density(1:nb))
     w%stress_force(1:nb, :) = blk%stress_global
     w%xi(1:nb) = 0

@@ -15,6 +15,7 @@ module driver_output
        field_writer_frame_count
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
   use fem_corotation, only: to_global
+  use driver_stop_condition, only: count_stop_columns, add_stop_columns, stop_column_values
   implicit none
   private
 
@@ -85,6 +86,7 @@ contains
                n = n + size(m%steps(i)%history_outputs(j)%node_variables)
        end do
     end do
+    n = n + count_stop_columns(m)
     allocate(columns(n))
     columns(1:11) = [character(len=32) :: 'time', 'step', 'step_time', 'increment', 'ALLKE', 'ALLIE', &
          'ALLVD', 'ALLFD', 'ALLWK', 'ALLAE', 'ETOTAL']
@@ -101,6 +103,7 @@ contains
           call add_set_columns(m, m%steps(i)%history_outputs(j), columns, n)
        end do
     end do
+    call add_stop_columns(m, columns, n)
     out%n_history_columns = n
     out%columns = columns(1:n)
     if (present(rows_done)) then
@@ -380,6 +383,7 @@ contains
        row(k) = 0
     end do
     call set_values(m, solver, istep, out%columns, row)
+    call stop_column_values(m, istep, solver, out%columns, row)
     call history_row(out%history, row)
     out%energy_peak = max(out%energy_peak, e(1), e(2), abs(e(5)))
     if (.not. out%balance_warned .and. solver%part%rank == 0) then

@@ -39,6 +39,11 @@ module driver_solver
      !> Pass F and U (defgradOld/New, stretchOld/New) to the VUMAT. Our own materials never
      !> read them, so blocks of our materials skip computing them (an effect not asked for).
      logical :: vumat_needs_kinematics = .true.
+     !> *FIXED MASS SCALING (driver_mass_scaling): factor on each element's inertia, allocated
+     !> only once a step scales. The inertia, the stable increment, hourglass and bulk viscosity
+     !> see ρ·factor; the VUMAT, gravity and the internal energy keep the physical mass.
+     logical :: mass_scaled = .false.
+     real(dp), allocatable :: mass_scale(:)
   end type element_block_t
 
   type, public :: rigid_body_t
@@ -80,6 +85,17 @@ module driver_solver
      ! Output schedule carried through a restart (driver_checkpoint -> driver_run).
      real(dp) :: restart_next_field = 0, restart_next_history = 0, restart_energy_reference = 0
      real(dp) :: restart_energy_peak = 0
+     ! Step stop condition (driver_stop_condition): displacements at the step start, the largest
+     ! displacement since then over the condition's node set, the kinetic-energy peak of the
+     ! step, the step time since which ALLKE stayed below the arrest fraction (< 0: not below),
+     ! the start time and u_max of the current growth window, and the outcome (0 undecided,
+     ! 1 FLOW, 2 ARREST). Checkpointed.
+     real(dp), allocatable :: u_step_start(:, :)
+     real(dp) :: stop_umax = 0, stop_ke = 0, stop_ke_peak = 0, stop_quiet_since = -1
+     real(dp) :: stop_window_start = 0, stop_window_umax = 0   !< displacement-growth window
+     integer :: stop_outcome = 0
+     integer, allocatable :: stop_nodes(:)            !< owned local nodes of the set (cache)
+     integer :: stop_nodes_step = 0                   !< step the cache was built for
   end type solver_t
 
   public :: build_blocks

@@ -43,7 +43,7 @@ contains
     case ('HEADING', 'NODE', 'ELEMENT', 'NSET', 'ELSET', 'SOLID SECTION', 'MATERIAL', &
          'SURFACE', 'RIGID BODY', 'SURFACE INTERACTION', 'INITIAL CONDITIONS', 'SECTION CONTROLS')
        keyword_kind = kw_model
-    case ('DYNAMIC', 'DLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART')
+    case ('DYNAMIC', 'DLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'FIXED MASS SCALING', 'STOP CONDITION')
        keyword_kind = kw_step_only
     case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR')
        keyword_kind = kw_anywhere

@@ -7,7 +7,10 @@
 !>   name, OP=NEW drops everything inherited (it must then be on every *BOUNDARY or
 !>   *DLOAD of the step, as in Abaqus); *CONTACT PAIR, OP=DELETE removes a pair;
 !> * *BULK VISCOSITY and *RESTART, WRITE stay in effect until changed;
-!> * *DYNAMIC, SCALE FACTOR= and DIRECT USER CONTROL belong to their step only.
+!> * *DYNAMIC, SCALE FACTOR= and DIRECT USER CONTROL belong to their step only;
+!> * *FIXED MASS SCALING carries over to later steps (Abaqus); a step with its own definitions
+!>   replaces all inherited ones (FACTOR=1 alone restores the physical masses);
+!> * *STOP CONDITION (ours) belongs to its step only.
 !>
 !> Model-data *BOUNDARY (zero displacements) and *CONTACT PAIR start the chain.
 module scene_steps
@@ -16,7 +19,8 @@ module scene_steps
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_text
   use model, only: model_t
   use model_sets, only: find_set, name_length
-  use model_steps, only: step_t, gravity_t, contact_pair_t
+  use model_steps, only: step_t, gravity_t, contact_pair_t, mass_scaling_t, mass_scaling_below_min, &
+       mass_scaling_uniform
   use scene_layout, only: scene_layout_t
   use scene_amplitudes, only: amplitude_param
   use scene_boundaries, only: bc_state_t, bc_init, bc_clear, read_boundary, bc_resolve, boundary_op
@@ -42,6 +46,8 @@ module scene_steps
      logical :: restart_write = .false.
      integer :: restart_number = 0
      real(dp) :: restart_time = 0
+     integer :: n_mass_scaling = 0
+     type(mass_scaling_t), allocatable :: mass_scaling(:)
   end type carry_t
 
 contains
@@ -55,7 +61,7 @@ contains
     integer :: i, s
 
     call bc_init(c%bcs, model%mesh%n_nodes)
-    allocate (c%gravity(0), c%pairs(0))
+    allocate (c%gravity(0), c%pairs(0), c%mass_scaling(0))
     do i = 1, deck%n_blocks
        if (layout%step_of(i) /= 0) cycle
        select case (deck%blocks(i)%name)
@@ -90,7 +96,7 @@ contains
     type(step_t), intent(inout) :: step
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: name
-    integer :: i, i0, i1, j, n_options, dynamic_block
+    integer :: i, i0, i1, j, n_options, dynamic_block, stop_block
     logical :: bc_new, dload_new
 
     i0 = layout%step_block(s)
@@ -118,6 +124,8 @@ contains
     if (dload_new) c%n_gravity = 0
     call outputs_step_start(c%outputs)
     dynamic_block = 0
+    stop_block = 0
+    step%mass_scaling_defined = .false.
     do i = i0 + 1, i1 - 1
        associate (blk => deck%blocks(i))
          select case (blk%name)
@@ -140,6 +148,19 @@ contains
             call read_bulk_viscosity(blk, c, err)
          case ('RESTART')
             call read_restart(blk, c, err)
+         case ('FIXED MASS SCALING')
+            ! The step's first definition replaces everything inherited.
+            if (.not. step%mass_scaling_defined) c%n_mass_scaling = 0
+            step%mass_scaling_defined = .true.
+            call read_mass_scaling(blk, model, c, err)
+         case ('STOP CONDITION')
+            if (stop_block /= 0) then
+               call blk%fail('second *STOP CONDITION in step ' // trim(step%name) // ' (first at ' // &
+                    where_text(deck%blocks(stop_block)%file, deck%blocks(stop_block)%line) // &
+                    '); expected at most one per step', err)
+               return
+            end if
+            stop_block = i
          case ('OUTPUT')
             n_options = 0
             do j = i + 1, i1 - 1
@@ -163,8 +184,13 @@ contains
             '*DYNAMIC, EXPLICIT with the time period', err)
        return
     end if
+    if (stop_block /= 0) then
+       call read_stop_condition(deck%blocks(stop_block), model, step, err)
+       if (err%raised) return
+    end if
     ! resolve everything active now into the step
     call bc_resolve(c%bcs, step%boundaries)
+    step%mass_scaling = c%mass_scaling(1:c%n_mass_scaling)
     step%gravity = c%gravity(1:c%n_gravity)
     step%contact_pairs = c%pairs(1:c%n_pairs)
     step%field_outputs = c%outputs%field(1:c%outputs%n_field)
@@ -496,4 +522,105 @@ contains
     end if
     c%restart_write = .true.
   end subroutine read_restart
+
+  !> *FIXED MASS SCALING [, FACTOR=f] [, DT=dt, TYPE=BELOW MIN|UNIFORM] [, ELSET=name]; no data.
+  subroutine read_mass_scaling(blk, model, c, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(model_t), intent(in) :: model
+    type(carry_t), intent(inout) :: c
+    type(error_t), intent(inout) :: err
+    type(mass_scaling_t) :: ms
+    type(mass_scaling_t), allocatable :: tmp(:)
+    character(len=:), allocatable :: kind, name
+
+    call blk%check_params([character(len=6) :: 'FACTOR', 'DT', 'TYPE', 'ELSET'], err)
+    if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
+    if (.not. err%raised) call get_real_param(blk, 'FACTOR', ms%factor, err, default=1.0_dp, positive=.true.)
+    if (.not. err%raised) call get_real_param(blk, 'DT', ms%dt, err, default=0.0_dp)
+    if (.not. err%raised) call blk%get_string('TYPE', kind, err, default='BELOW MIN', &
+         choices=[character(len=9) :: 'BELOW MIN', 'UNIFORM'])
+    if (err%raised) return
+    if (blk%has_param('DT') .and. .not. (ms%dt > 0)) then
+       call blk%fail('*FIXED MASS SCALING: DT=' // rtoa(ms%dt) // ' is not positive; expected a target ' // &
+            'element stable time increment > 0', err)
+       return
+    end if
+    if (blk%has_param('TYPE') .and. .not. blk%has_param('DT')) then
+       call blk%fail('*FIXED MASS SCALING: TYPE=' // kind // ' without DT; expected DT=<target increment> ' // &
+            'with TYPE', err)
+       return
+    end if
+    ms%kind = mass_scaling_below_min
+    if (kind == 'UNIFORM') ms%kind = mass_scaling_uniform
+    if (blk%has_param('ELSET')) then
+       call blk%get_string('ELSET', name, err)
+       if (err%raised) return
+       ms%elset = find_set(model%elsets, model%n_elsets, name)
+       if (ms%elset == 0) then
+          call blk%fail('element set ' // name // ' is not defined; expected the name of an *ELSET ' // &
+               '(or no ELSET: all elements)', err)
+          return
+       end if
+    end if
+    if (c%n_mass_scaling >= size(c%mass_scaling)) then
+       allocate (tmp(2 * c%n_mass_scaling + 2))
+       tmp(1:c%n_mass_scaling) = c%mass_scaling(1:c%n_mass_scaling)
+       call move_alloc(tmp, c%mass_scaling)
+    end if
+    c%n_mass_scaling = c%n_mass_scaling + 1
+    c%mass_scaling(c%n_mass_scaling) = ms
+  end subroutine read_mass_scaling
+
+  !> *STOP CONDITION, NSET=name, DISPLACEMENT=d [, KINETIC FRACTION=f] [, HOLD=t] [, MIN TIME=t]
+  !> [, GROWTH=g] (ours); no data lines. HOLD defaults to 5 % of the step period.
+  subroutine read_stop_condition(blk, model, step, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(model_t), intent(in) :: model
+    type(step_t), intent(inout) :: step
+    type(error_t), intent(inout) :: err
+    character(len=:), allocatable :: name
+
+    call blk%check_params([character(len=16) :: 'NSET', 'DISPLACEMENT', 'KINETIC FRACTION', 'HOLD', &
+         'MIN TIME', 'GROWTH'], err)
+    if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
+    if (.not. err%raised) call blk%get_string('NSET', name, err)
+    if (err%raised) return
+    step%stop%nset = find_set(model%nsets, model%n_nsets, name)
+    if (step%stop%nset == 0) then
+       call blk%fail('node set ' // name // ' is not defined; expected the name of an *NSET whose ' // &
+            'displacements decide FLOW', err)
+       return
+    end if
+    if (.not. blk%has_param('DISPLACEMENT')) then
+       call blk%fail('*STOP CONDITION without DISPLACEMENT; expected DISPLACEMENT=<limit> (e.g. half ' // &
+            'an element length)', err)
+       return
+    end if
+    call get_real_param(blk, 'DISPLACEMENT', step%stop%displacement, err, positive=.true.)
+    if (.not. err%raised) call get_real_param(blk, 'KINETIC FRACTION', step%stop%ke_fraction, err, &
+         default=0.01_dp, positive=.true.)
+    if (.not. err%raised) call get_real_param(blk, 'HOLD', step%stop%hold, err, default=0.05_dp * step%period, &
+         positive=.true.)
+    if (.not. err%raised) call get_real_param(blk, 'MIN TIME', step%stop%min_time, err, default=0.0_dp)
+    if (.not. err%raised) call get_real_param(blk, 'GROWTH', step%stop%growth, err, default=0.05_dp)
+    if (err%raised) return
+    if (step%stop%growth < 0 .or. .not. (step%stop%growth < 1)) then
+       call blk%fail('*STOP CONDITION: GROWTH=' // rtoa(step%stop%growth) // ' is outside [0, 1); ' // &
+            'expected the largest growth of the displacement over HOLD, as a fraction of DISPLACEMENT ' // &
+            '(0: the kinetic-energy rule only)', err)
+       return
+    end if
+    if (.not. (step%stop%ke_fraction < 1)) then
+       call blk%fail('*STOP CONDITION: KINETIC FRACTION=' // rtoa(step%stop%ke_fraction) // &
+            ' is not below 1; expected a fraction 0 < f < 1 of the peak kinetic energy', err)
+       return
+    end if
+    if (step%stop%min_time < 0 .or. step%stop%min_time + step%stop%hold > step%period) then
+       call blk%fail('*STOP CONDITION: MIN TIME + HOLD = ' // rtoa(step%stop%min_time + step%stop%hold) // &
+            ' exceeds the step period ' // rtoa(step%period) // '; expected MIN TIME >= 0 and ' // &
+            'MIN TIME + HOLD <= period', err)
+       return
+    end if
+    step%stop%active = .true.
+  end subroutine read_stop_condition
 end module scene_steps

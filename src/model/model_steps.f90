@@ -61,6 +61,35 @@ module model_steps
      character(len=8), allocatable :: node_variables(:)     !< e.g. RF1, RF2, U2, V2 summed/averaged over nset
   end type history_output_t
 
+  integer, parameter, public :: mass_scaling_below_min = 1
+  integer, parameter, public :: mass_scaling_uniform = 2
+
+  !> *FIXED MASS SCALING: element masses scaled once at the start of the step that defines it
+  !> (first by `factor`, then, with dt > 0, to reach the element stable increment dt: only the
+  !> elements below it (BELOW MIN) or all by one factor (UNIFORM)). Abaqus's semantics: a step
+  !> without its own definition keeps the scaled masses of the step before.
+  type, public :: mass_scaling_t
+     integer :: elset = 0                     !< element set, 0: all elements
+     real(dp) :: factor = 1
+     real(dp) :: dt = 0                       !< target element stable increment, 0: none
+     integer :: kind = mass_scaling_below_min
+  end type mass_scaling_t
+
+  !> *STOP CONDITION (ours): end the run early once the step's outcome is clear. FLOW: the largest
+  !> displacement since the step start over the node set exceeds `displacement`; ARREST (from
+  !> `min_time` on, the displacement still below the limit): the kinetic energy stays below
+  !> `ke_fraction` of its peak in the step for `hold` step time, or the largest displacement grows
+  !> by at most `growth` × `displacement` over a window of `hold` step time.
+  type, public :: stop_condition_t
+     logical :: active = .false.
+     integer :: nset = 0
+     real(dp) :: displacement = 0
+     real(dp) :: ke_fraction = 0.01_dp
+     real(dp) :: hold = 0
+     real(dp) :: min_time = 0
+     real(dp) :: growth = 0.05_dp
+  end type stop_condition_t
+
   type, public :: step_t
      character(len=name_length) :: name = ''
      real(dp) :: period = 0                   !< *DYNAMIC, EXPLICIT time period (> 0)
@@ -75,6 +104,11 @@ module model_steps
      type(history_output_t), allocatable :: history_outputs(:)
      real(dp) :: restart_interval = 0         !< *RESTART, WRITE: checkpoint every this much step time (0: at step end only if requested)
      logical :: restart_write = .false.
+     !> Mass scaling active in the step (inherited or its own); recomputed at the step start only
+     !> when the step defines it (`mass_scaling_defined`).
+     type(mass_scaling_t), allocatable :: mass_scaling(:)
+     logical :: mass_scaling_defined = .false.
+     type(stop_condition_t) :: stop
      character(len=256) :: source = ''
   end type step_t
 end module model_steps
