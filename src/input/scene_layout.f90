@@ -41,11 +41,12 @@ contains
 
     select case (name)
     case ('HEADING', 'NODE', 'ELEMENT', 'NSET', 'ELSET', 'SOLID SECTION', 'MATERIAL', &
-         'SURFACE', 'RIGID BODY', 'SURFACE INTERACTION', 'INITIAL CONDITIONS', 'SECTION CONTROLS')
+         'SURFACE', 'RIGID BODY', 'SURFACE INTERACTION', 'INITIAL CONDITIONS', 'SECTION CONTROLS', &
+         'MPM GRID', 'PARTICLES', 'OUTFLOW')
        keyword_kind = kw_model
-    case ('DYNAMIC', 'DLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART')
+    case ('DYNAMIC', 'DLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'INFLOW')
        keyword_kind = kw_step_only
-    case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR')
+    case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR', 'MPM CONTROLS', 'MPM WALL')
        keyword_kind = kw_anywhere
     case ('FRICTION')
        keyword_kind = kw_interaction_option
