@@ -37,8 +37,14 @@ program bulkflow
   call read_scene(scene, m, err)
   if (err%raised) call input_error_exit(err)
   if (check_only) then
-     if (rank == 0) write (output_unit, '(a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (', &
-          m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, ' elements, ', m%n_steps, ' steps)'
+     if (rank == 0 .and. m%mpm%active) then
+        write (output_unit, '(a,i0,a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (material points, ', &
+             m%mpm%ndim, 'D, ', size(m%mpm%regions), ' particle regions, ', size(m%mpm%walls), ' walls, ', &
+             m%n_steps, ' steps)'
+     else if (rank == 0) then
+        write (output_unit, '(a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (', &
+             m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, ' elements, ', m%n_steps, ' steps)'
+     end if
   else if (m%mpm%active) then
      call run_mpm(m, opts)
   else

@@ -36,9 +36,9 @@ module mpm_particles
 
 contains
 
-  !> Allocate a block of n particles (contents undefined except the identities and zeros).
+  !> A block of n particles (zeros, F = R = I); whatever b held before is released.
   subroutine block_allocate(b, n, ndim, ncomp, nstatev, nfieldv, ns)
-    type(particle_block_t), intent(inout) :: b
+    type(particle_block_t), intent(out) :: b
     integer, intent(in) :: n, ndim, ncomp, nstatev, nfieldv, ns
     integer :: k
 

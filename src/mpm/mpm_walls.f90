@@ -74,8 +74,9 @@ contains
   end subroutine wall_find_nodes
 
   !> Project the velocities v(ndim, nn) of the wall's active nodes; with `force`, add the
-  !> force the material exerts on the wall, −Σ m Δv / Δt, and the kinetic energy the wall takes
-  !> out, Σ ½ m (|v|² − |v_new|²) >= 0, into `dissipated`.
+  !> force the material exerts on the wall, −Σ m Δv / Δt, and the kinetic energy friction takes
+  !> out of the tangential motion, Σ ½ m (|v_t|² − |v_t,new|²) >= 0, into `dissipated` (the
+  !> normal velocity a wall removes is the reaction to the stress of a resting body, not a loss).
   subroutine wall_project(w, wn, ndim, mass, active, v, dt, force, dissipated)
     type(mpm_wall_t), intent(in) :: w
     type(wall_nodes_t), intent(in) :: wn
@@ -88,6 +89,9 @@ contains
     real(dp), intent(inout), optional :: dissipated
     integer :: k, i
     real(dp) :: n(3), vi(3), vn, vt(3), tn, scale, vnew(3)
+
+    tn = 0
+    scale = 1
 
     n = w%normal
     do k = 1, size(wn%nodes)
@@ -107,8 +111,8 @@ contains
           vnew = vt * scale
        end if
        if (present(force)) force = force - mass(i) * (vnew - vi) / dt
-       if (present(dissipated)) dissipated = dissipated + 0.5_dp * mass(i) * &
-            (dot_product(vi, vi) - dot_product(vnew, vnew))
+       if (present(dissipated) .and. w%kind /= wall_symmetry) dissipated = dissipated + 0.5_dp * mass(i) * &
+            tn * tn * (1 - scale * scale)
        v(:, i) = vnew(1:ndim)
     end do
   end subroutine wall_project
