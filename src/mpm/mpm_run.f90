@@ -73,6 +73,8 @@ module mpm_run
      logical, allocatable :: on_wall(:)              !< grid nodes of the walls active in this step
      ! time
      integer :: step = 0, increment = 0
+     integer(int64) :: particle_steps = 0           !< Σ over increments of the particle count
+     real(dp) :: loop_seconds = 0                    !< wall time of the time loop
      real(dp) :: total_time = 0, step_time = 0, dt = 0, dt_stable = 0
      real(dp) :: gravity(3) = 0
   end type mpm_state_t
@@ -95,7 +97,7 @@ contains
     real(dp) :: next_field, next_history, field_dt, history_dt, last_row_time, last_row_out
     real(dp) :: period, eps
     integer :: s, k, nsdv
-    integer(int64) :: clock_last, clock_now, clock_rate
+    integer(int64) :: clock_last, clock_now, clock_rate, clock_start
     logical :: stop_now
 
     call setup(m, st, fx)
@@ -113,6 +115,7 @@ contains
     last_row_out = 0
     call write_history(m, st, hist, last_row_time, last_row_out)
     call system_clock(clock_last, clock_rate)
+    clock_start = clock_last
     stop_now = .false.
     do s = 1, m%n_steps
        st%step = s
@@ -127,6 +130,7 @@ contains
           call stable_increment(m, st)
           st%dt = min(st%dt_stable, period - st%step_time)
           if (m%steps(s)%dt_fixed > 0) st%dt = min(m%steps(s)%dt_fixed, period - st%step_time)
+          st%particle_steps = st%particle_steps + sum(st%blocks(1:st%nblocks)%count)
           call increment(m, st, fx)
           st%step_time = st%step_time + st%dt
           st%total_time = st%total_time + st%dt
@@ -162,6 +166,8 @@ contains
        end do
        if (stop_now) exit
     end do
+    call system_clock(clock_now)
+    st%loop_seconds = real(clock_now - clock_start, dp) / real(clock_rate, dp)
     call mpm_writer_close(wr)
     call history_close(hist)
     call summary(m, st, fx, stop_now)
@@ -1054,6 +1060,8 @@ contains
        write (output_unit, '(a,3es13.5)') '  wall ' // trim(m%mpm%walls(k)%name) // ' force:', st%wall_force(:, k)
     end do
     if (st%n_guarded > 0) write (output_unit, '(a,i0)') '  particles put back onto walls: ', st%n_guarded
+    write (output_unit, '(a,i0,a,es11.4,a,f10.3,a)') '  throughput ', st%particle_steps, ' particle-steps, ', &
+         real(st%particle_steps, dp) / max(st%loop_seconds, 1.0e-9_dp), ' per second (time loop ', st%loop_seconds, ' s)'
     call timer_report(fx%timers, output_unit)
   end subroutine summary
 end module mpm_run
