@@ -66,7 +66,7 @@ def main():
                OMPI_MCA_rmaps_base_oversubscribe="1")
     r, _ = run(["mpirun", "-np", "2", a.bulkflow, str(tmp / "hopper_gimp.inp"), "--output",
                 str(tmp / "np2"), "--quiet", "--stop-after", "10"], env=env)
-    msg = (r.stderr.strip().splitlines() or [""])[-1]
+    msg = next((l for l in (r.stdout + r.stderr).splitlines() if "bulkflow: error" in l), "(no message)")
     print(f"  2 ranks: exit status {r.returncode}: {msg}")
     if a.discharge > 0:
         scene = tmp / "hopper_discharge.inp"

@@ -467,12 +467,9 @@ contains
 
     ! G2P and the MUSL remap
     call timer_start(fx%timers, fx%id(fx_g2p))
-    do ib = 1, st%nblocks
-       call g2p(m, st, st%blocks(ib))
-    end do
     st%g%mom = 0
     do ib = 1, st%nblocks
-       call remap(st, st%blocks(ib))
+       call g2p(m, st, st%blocks(ib))
     end do
     do i = 1, st%g%nn
        if (st%g%active(i)) then
@@ -532,51 +529,143 @@ contains
     end if
   end subroutine stencil
 
-  !> Particle to grid: mass, momentum, internal and gravity forces.
+  !> Particle to grid: mass, momentum, internal and gravity forces. The particle factors
+  !> (m v, V σ, m g) are formed first in block loops that vectorize; the scatter then does one
+  !> multiply-add per value and node.
   subroutine p2g(st, b)
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(in) :: b
-    integer :: s, p, i, nd, ns
-    real(dp) :: vol(b%count), wm, g(3)
+    integer :: p, nd, ns, nb
+    real(dp) :: vol
+    real(dp) :: mv(b%count, st%nd), vs(b%count, st%nc), mg(b%count, st%nd)
 
     nd = st%nd
     ns = st%ns
-    g = st%gravity
-    do p = 1, b%count
-       vol(p) = b%vol0(p) * det_f(b, p, nd)
+    nb = b%count
+    do p = 1, nb
+       vol = b%vol0(p) * det_f(b, p, nd)
+       vs(p, :) = vol * b%stress_global(p, :)
+       mv(p, :) = b%mass(p) * b%v(p, :)
+       mg(p, :) = b%mass(p) * st%gravity(1:nd)
     end do
-    associate (mass => st%g%mass, mom => st%g%mom, force => st%g%force, sg => b%stress_global)
-      if (nd == 2) then
-         do s = 1, ns
-            do p = 1, b%count
-               i = b%node(p, s)
-               wm = b%w(p, s) * b%mass(p)
-               mass(i) = mass(i) + wm
-               mom(1, i) = mom(1, i) + wm * b%v(p, 1)
-               mom(2, i) = mom(2, i) + wm * b%v(p, 2)
-               force(1, i) = force(1, i) - vol(p) * (sg(p, 1) * b%dw(p, s) + sg(p, 4) * b%dw(p, ns + s)) + wm * g(1)
-               force(2, i) = force(2, i) - vol(p) * (sg(p, 4) * b%dw(p, s) + sg(p, 2) * b%dw(p, ns + s)) + wm * g(2)
-            end do
-         end do
-      else
-         ! 3D VUMAT order 11, 22, 33, 12, 23, 31
-         do s = 1, ns
-            do p = 1, b%count
-               i = b%node(p, s)
-               wm = b%w(p, s) * b%mass(p)
-               mass(i) = mass(i) + wm
-               mom(:, i) = mom(:, i) + wm * b%v(p, :)
-               force(1, i) = force(1, i) - vol(p) * (sg(p, 1) * b%dw(p, s) + sg(p, 4) * b%dw(p, ns + s) + &
-                    sg(p, 6) * b%dw(p, 2 * ns + s)) + wm * g(1)
-               force(2, i) = force(2, i) - vol(p) * (sg(p, 4) * b%dw(p, s) + sg(p, 2) * b%dw(p, ns + s) + &
-                    sg(p, 5) * b%dw(p, 2 * ns + s)) + wm * g(2)
-               force(3, i) = force(3, i) - vol(p) * (sg(p, 6) * b%dw(p, s) + sg(p, 5) * b%dw(p, ns + s) + &
-                    sg(p, 3) * b%dw(p, 2 * ns + s)) + wm * g(3)
-            end do
-         end do
-      end if
-    end associate
+    if (nd == 2) then
+       call scatter_2d(nb, ns, st%g%nn, b%node, b%w, b%dw, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
+    else
+       call scatter_3d(nb, ns, st%g%nn, b%node, b%w, b%dw, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
+    end if
   end subroutine p2g
+
+  !> The P2G scatter of a 2D block. Explicit-shape dummies: on the allocatable components the
+  !> compiler reloaded the array descriptors at every store (the loop is store-bound).
+  pure subroutine scatter_2d(nb, ns, nn, node, w, dw, mp, mv, vs, mg, gmass, gmom, gforce)
+    integer, intent(in) :: nb, ns, nn
+    integer, intent(in) :: node(nb, ns)
+    real(dp), intent(in) :: w(nb, ns), dw(nb, 2 * ns), mp(nb), mv(nb, 2), vs(nb, 4), mg(nb, 2)
+    real(dp), intent(inout) :: gmass(nn), gmom(2, nn), gforce(2, nn)
+    integer :: s, p, i
+    real(dp) :: wp, dx, dy
+
+    do s = 1, ns
+       do p = 1, nb
+          i = node(p, s)
+          wp = w(p, s)
+          dx = dw(p, s)
+          dy = dw(p, ns + s)
+          gmass(i) = gmass(i) + wp * mp(p)
+          gmom(1, i) = gmom(1, i) + wp * mv(p, 1)
+          gmom(2, i) = gmom(2, i) + wp * mv(p, 2)
+          gforce(1, i) = gforce(1, i) + (wp * mg(p, 1) - (vs(p, 1) * dx + vs(p, 4) * dy))
+          gforce(2, i) = gforce(2, i) + (wp * mg(p, 2) - (vs(p, 4) * dx + vs(p, 2) * dy))
+       end do
+    end do
+  end subroutine scatter_2d
+
+  !> The P2G scatter of a 3D block (stress in VUMAT order 11, 22, 33, 12, 23, 31).
+  pure subroutine scatter_3d(nb, ns, nn, node, w, dw, mp, mv, vs, mg, gmass, gmom, gforce)
+    integer, intent(in) :: nb, ns, nn
+    integer, intent(in) :: node(nb, ns)
+    real(dp), intent(in) :: w(nb, ns), dw(nb, 3 * ns), mp(nb), mv(nb, 3), vs(nb, 6), mg(nb, 3)
+    real(dp), intent(inout) :: gmass(nn), gmom(3, nn), gforce(3, nn)
+    integer :: s, p, i
+    real(dp) :: wp, dx, dy, dz
+
+    do s = 1, ns
+       do p = 1, nb
+          i = node(p, s)
+          wp = w(p, s)
+          dx = dw(p, s)
+          dy = dw(p, ns + s)
+          dz = dw(p, 2 * ns + s)
+          gmass(i) = gmass(i) + wp * mp(p)
+          gmom(1, i) = gmom(1, i) + wp * mv(p, 1)
+          gmom(2, i) = gmom(2, i) + wp * mv(p, 2)
+          gmom(3, i) = gmom(3, i) + wp * mv(p, 3)
+          gforce(1, i) = gforce(1, i) + (wp * mg(p, 1) - (vs(p, 1) * dx + vs(p, 4) * dy + vs(p, 6) * dz))
+          gforce(2, i) = gforce(2, i) + (wp * mg(p, 2) - (vs(p, 4) * dx + vs(p, 2) * dy + vs(p, 5) * dz))
+          gforce(3, i) = gforce(3, i) + (wp * mg(p, 3) - (vs(p, 6) * dx + vs(p, 5) * dy + vs(p, 3) * dz))
+       end do
+    end do
+  end subroutine scatter_3d
+
+  !> Σ_s w v_new and Σ_s w (v_new − v_old) at the particles of a block (G2P gather).
+  pure subroutine gather_velocity(nb, ns, nd, nn, node, w, v_new, v_old, vpic, dv)
+    integer, intent(in) :: nb, ns, nd, nn
+    integer, intent(in) :: node(nb, ns)
+    real(dp), intent(in) :: w(nb, ns), v_new(nd, nn), v_old(nd, nn)
+    real(dp), intent(out) :: vpic(nb, nd), dv(nb, nd)
+    integer :: s, p, i, k
+
+    vpic = 0
+    dv = 0
+    do s = 1, ns
+       do p = 1, nb
+          i = node(p, s)
+          do k = 1, nd
+             vpic(p, k) = vpic(p, k) + w(p, s) * v_new(k, i)
+             dv(p, k) = dv(p, k) + w(p, s) * (v_new(k, i) - v_old(k, i))
+          end do
+       end do
+    end do
+  end subroutine gather_velocity
+
+  !> MUSL remap of a block: gmom += Σ_s w (m v)_p.
+  pure subroutine scatter_momentum(nb, ns, nd, nn, node, w, mv, gmom)
+    integer, intent(in) :: nb, ns, nd, nn
+    integer, intent(in) :: node(nb, ns)
+    real(dp), intent(in) :: w(nb, ns), mv(nb, nd)
+    real(dp), intent(inout) :: gmom(nd, nn)
+    integer :: s, p, i, k
+
+    do s = 1, ns
+       do p = 1, nb
+          i = node(p, s)
+          do k = 1, nd
+             gmom(k, i) = gmom(k, i) + w(p, s) * mv(p, k)
+          end do
+       end do
+    end do
+  end subroutine scatter_momentum
+
+  !> Velocity gradient L(p, a, c) = Σ_s v_a(node) ∂S/∂x_c of a block.
+  pure subroutine gather_gradient(nb, ns, nd, nn, node, dw, v, l)
+    integer, intent(in) :: nb, ns, nd, nn
+    integer, intent(in) :: node(nb, ns)
+    real(dp), intent(in) :: dw(nb, nd * ns), v(nd, nn)
+    real(dp), intent(out) :: l(nb, nd, nd)
+    integer :: s, p, i, a, c
+
+    l = 0
+    do s = 1, ns
+       do p = 1, nb
+          i = node(p, s)
+          do c = 1, nd
+             do a = 1, nd
+                l(p, a, c) = l(p, a, c) + v(a, i) * dw(p, (c - 1) * ns + s)
+             end do
+          end do
+       end do
+    end do
+  end subroutine gather_gradient
 
   !> v_I^n = p_I/m_I; [local damping f ← f − a|f| sgn v]; v_I^{n+1} = v_I^n + Δt f_I/m_I.
   subroutine grid_update(m, st)
@@ -604,54 +693,34 @@ contains
     end do
   end subroutine grid_update
 
-  !> Grid to particles: PIC/FLIP blend of the velocity, position from the new grid velocity.
+  !> Grid to particles: PIC/FLIP blend of the velocity, position from the new grid velocity;
+  !> then (MUSL) the block's new momentum goes back to the grid (st%g%mom, zeroed by the caller)
+  !> while its stencil is at hand.
   subroutine g2p(m, st, b)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(inout) :: b
-    integer :: s, p, i, k, nd
+    integer :: p, k, nd, nb
     real(dp) :: alpha, vpic(b%count, st%nd), dv(b%count, st%nd), dt, wk
 
     nd = st%nd
+    nb = b%count
     alpha = m%mpm%steps(st%step)%flip
     dt = st%dt
-    vpic = 0
-    dv = 0
-    do s = 1, st%ns
-       do k = 1, nd
-          do p = 1, b%count
-             i = b%node(p, s)
-             vpic(p, k) = vpic(p, k) + b%w(p, s) * st%g%v_new(k, i)
-             dv(p, k) = dv(p, k) + b%w(p, s) * (st%g%v_new(k, i) - st%g%v_old(k, i))
-          end do
-       end do
-    end do
+    call gather_velocity(nb, st%ns, nd, st%g%nn, b%node, b%w, st%g%v_new, st%g%v_old, vpic, dv)
     wk = 0
     do k = 1, nd
-       do p = 1, b%count
+       do p = 1, nb
           b%v(p, k) = alpha * (b%v(p, k) + dv(p, k)) + (1 - alpha) * vpic(p, k)
           b%x(p, k) = b%x(p, k) + dt * vpic(p, k)
           wk = wk + b%mass(p) * st%gravity(k) * dt * vpic(p, k)
+          ! from here on dv holds the particle momentum for the remap
+          dv(p, k) = b%mass(p) * b%v(p, k)
        end do
     end do
     st%w_external = st%w_external + wk
+    call scatter_momentum(nb, st%ns, nd, st%g%nn, b%node, b%w, dv, st%g%mom)
   end subroutine g2p
-
-  !> MUSL: momentum from the updated particle velocities.
-  subroutine remap(st, b)
-    type(mpm_state_t), intent(inout) :: st
-    type(particle_block_t), intent(in) :: b
-    integer :: s, p, i, k
-
-    do s = 1, st%ns
-       do k = 1, st%nd
-          do p = 1, b%count
-             i = b%node(p, s)
-             st%g%mom(k, i) = st%g%mom(k, i) + b%w(p, s) * b%mass(p) * b%v(p, k)
-          end do
-       end do
-    end do
-  end subroutine remap
 
   !> Velocity gradient from the remapped grid velocities, F, the corotational increments, and
   !> the material call on the block (the element blocks' door).
@@ -660,7 +729,7 @@ contains
     type(mpm_state_t), intent(inout) :: st
     type(mpm_effects_t), intent(inout) :: fx
     type(particle_block_t), intent(inout) :: b
-    integer :: nb, nd, s, p, i, a, c, k
+    integer :: nb, nd, p, a, c, k
     real(dp) :: dt
     real(dp) :: l(b%count, st%nd, st%nd), f_mid(b%count, st%nd, st%nd), f_new(b%count, st%nd, st%nd)
     real(dp) :: r_mid(b%count, st%nd, st%nd), r_new(b%count, st%nd, st%nd)
@@ -671,17 +740,7 @@ contains
     nb = b%count
     nd = st%nd
     dt = st%dt
-    l = 0
-    do s = 1, st%ns
-       do c = 1, nd
-          do a = 1, nd
-             do p = 1, nb
-                i = b%node(p, s)
-                l(p, a, c) = l(p, a, c) + st%g%v_new(a, i) * b%dw(p, (c - 1) * st%ns + s)
-             end do
-          end do
-       end do
-    end do
+    call gather_gradient(nb, st%ns, nd, st%g%nn, b%node, b%dw, st%g%v_new, l)
     ! F_{n+1} = (I + L Δt) F_n, F_{n+½} = (I + ½ L Δt) F_n
     f_new = b%f
     f_mid = b%f
