@@ -320,7 +320,7 @@ contains
     real(dp) :: t(3), length
 
     nd = mpm%ndim
-    call blk%check_params([character(len=8) :: 'NAME', 'TYPE', 'FRICTION', 'OP'], err)
+    call blk%check_params([character(len=8) :: 'NAME', 'TYPE', 'FRICTION', 'OP', 'REACH'], err)
     if (.not. err%raised) call blk%get_string('NAME', name, err)
     if (.not. err%raised) call check_name(blk, 'wall', name, wall_name_length, err)
     if (.not. err%raised) call blk%get_string('OP', op, err, default='NEW', choices=[character(len=6) :: &
@@ -337,8 +337,9 @@ contains
        else if (found == 0) then
           call blk%fail('*MPM WALL, OP=DELETE: wall ' // name // ' is not defined; expected the NAME of an ' // &
                'earlier *MPM WALL', err)
-       else if (blk%has_param('TYPE') .or. blk%has_param('FRICTION') .or. blk%n_lines > 0) then
-          call blk%fail('*MPM WALL, OP=DELETE takes only NAME; expected no TYPE, FRICTION or data lines', err)
+       else if (blk%has_param('TYPE') .or. blk%has_param('FRICTION') .or. blk%has_param('REACH') .or. &
+            blk%n_lines > 0) then
+          call blk%fail('*MPM WALL, OP=DELETE takes only NAME; expected no TYPE, FRICTION, REACH or data lines', err)
        else
           mpm%walls(found)%active(s:) = .false.
        end if
@@ -353,6 +354,7 @@ contains
     w%source = where_text(blk%file, blk%line)
     call blk%get_string('TYPE', kind, err, default='FRICTION', choices=[character(len=8) :: 'FRICTION', 'SYMMETRY'])
     if (.not. err%raised) call blk%get_real('FRICTION', w%friction, err, default=0.0_dp, minimum=0.0_dp)
+    if (.not. err%raised) call blk%get_real('REACH', w%reach, err, default=0.0_dp, minimum=0.0_dp, maximum=0.99_dp)
     if (err%raised) return
     w%kind = wall_friction
     if (kind == 'SYMMETRY') then

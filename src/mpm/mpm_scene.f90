@@ -36,6 +36,7 @@ module mpm_scene
      character(len=wall_name_length) :: name = ''
      integer :: kind = wall_friction
      real(dp) :: friction = 0               !< Coulomb μ = tan δ_w
+     real(dp) :: reach = 0                  !< nodes up to reach·h in front of the wall are constrained too
      real(dp) :: p0(3) = 0, p1(3) = 0
      real(dp) :: normal(3) = 0              !< unit, into the material
      logical :: bounded = .false.           !< 3D: limited to lo..hi

@@ -4,8 +4,8 @@
 !> tangential one by μ |Δv_n| (Coulomb; stick when that exceeds it); a symmetry wall removes
 !> the normal velocity both ways.
 !>
-!> Which nodes: those with signed distance d = (x_I − p0)·n <= 0 (on the wall or behind it) whose
-!> projection falls on the wall (2D: the segment p0..p1; 3D: the optional box). A grid-aligned
+!> Which nodes: those with signed distance d = (x_I − p0)·n <= REACH·h (default 0: on the wall or
+!> behind it) whose projection falls on the wall (2D: the segment p0..p1; 3D: the optional box). A grid-aligned
 !> wall thus acts on its node line exactly as a standard MPM boundary; an inclined wall acts on
 !> the staircase of nodes just behind it, with the exact normal (no staircase friction).
 !> Particles that end an increment behind a wall (the wall's stencil is one cell wide) are put
@@ -64,7 +64,7 @@ contains
     n = 0
     do i = 1, g%nn
        x = g%position(i)
-       if (wall_distance(w, x) > tol) cycle
+       if (wall_distance(w, x) > w%reach * g%h + tol) cycle
        if (.not. wall_contains(w, g%ndim, x, tol)) cycle
        n = n + 1
        list(n) = i
