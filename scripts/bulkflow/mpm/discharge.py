@@ -5,7 +5,8 @@
 BASE is the run's output base (BASE_history.csv, BASE.h5). Figures (2D: per metre of depth of the
 half model; double them for the full hopper):
 - MDR: slope of a linear regression of the discharged mass (MASS_OUT) against time from
-  `--skip` seconds after the outlet opens (start of step 2) up to T_ss;
+  `--skip` seconds after the outlet opens (start of step 2) up to T_ss (thesis), and the same up
+  to the end of the run (steady runs with inflow);
 - T_ss (thesis §5.5.2): instantaneous MDRs over windows of `--window` s from `--skip` s after
   opening; T_ss is the end of the last window before the first one that differs by more than 10 %
   from the mean of the windows before it (the whole run when none does);
@@ -21,7 +22,7 @@ import sys
 import numpy as np
 
 
-def discharge_rate(hist, skip=0.5, window=0.1, tolerance=0.10):
+def discharge_rate(hist, skip=0.5, window=0.2, tolerance=0.10):
     t = hist["time"]
     step = hist["step"]
     i2 = int(np.argmax(step >= 2))
@@ -41,6 +42,17 @@ def discharge_rate(hist, skip=0.5, window=0.1, tolerance=0.10):
     m = (t >= t0) & (t <= t_ss)
     mdr = np.polyfit(t[m], mass[m], 1)[0] if m.sum() >= 2 else float("nan")
     return mdr, t_ss - opened, opened, np.array(rates), edges
+
+
+def mean_discharge_rate(hist, skip=0.5):
+    """Regression slope of MASS_OUT over the whole discharge from `skip` s after opening (for runs
+    with inflow, whose discharge stays steady to the end; less sensitive to window noise)."""
+    t = hist["time"]
+    step = hist["step"]
+    i2 = int(np.argmax(step >= 2))
+    opened = t[i2] - hist["step_time"][i2] if np.any(step >= 2) else t[0]
+    m = t >= opened + skip
+    return np.polyfit(t[m], hist["MASS_OUT"][m], 1)[0] if m.sum() >= 2 else float("nan")
 
 
 def mass_flow_index(h5path, theta=30.0, outlet=0.25, height=3.0):
@@ -79,7 +91,7 @@ def main(argv=None):
     p.add_argument("--outlet", type=float, default=0.25)
     p.add_argument("--height", type=float, default=3.0)
     p.add_argument("--skip", type=float, default=0.5)
-    p.add_argument("--window", type=float, default=0.1)
+    p.add_argument("--window", type=float, default=0.2)
     p.add_argument("--plot")
     a = p.parse_args(argv)
     hist = np.genfromtxt(a.base + "_history.csv", delimiter=",", names=True)
@@ -88,6 +100,8 @@ def main(argv=None):
           f"in {hist['MASS_IN'][-1]:.6g} kg, max |mass balance error| {np.abs(hist['MASS_ERROR']).max():.3e} kg")
     print(f"MDR (half model, per m depth) = {mdr:.6g} kg/s/m; full hopper {2 * mdr:.6g} kg/s/m")
     print(f"T_ss = {t_ss:.4f} s after opening (windows of {a.window:g} s from {a.skip:g} s)")
+    mean = mean_discharge_rate(hist, a.skip)
+    print(f"mean MDR from {a.skip:g} s after opening to the end: {mean:.6g} kg/s/m (full hopper {2 * mean:.6g})")
     beverloo = 0.58 * 1600 * math.sqrt(9.81) * a.outlet ** 1.5
     print(f"  for scale: 2D Beverloo C rho sqrt(g) b^1.5 with C = 0.58, rho = 1600: {beverloo:.6g} kg/s/m (full)")
     try:
