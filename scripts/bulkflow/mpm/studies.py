@@ -1,7 +1,13 @@
-"""MPM hopper studies: grid convergence with its accuracy-vs-cost table (study a / item 6).
+"""MPM hopper studies: grid convergence with its accuracy-vs-cost table (study a / item 6), and
+the discharge rate and flow mode against outlet width and hopper angle (studies e, f).
 
     bulkflow-mpm-study convergence --cells 0.1 0.07 0.05 [--discharge 1.5] [--out out/mpm_study]
                                    [--bulkflow build/bin/bulkflow] [--shape GIMP|LINEAR]
+    bulkflow-mpm-study sweep --outlets 0.15 0.25 0.35 --thetas 15 30 45 [--cell 0.05] ...
+
+sweep: every (theta, b) pair with the other at its Table 4.2 value (30 deg, 0.25 m); prints the
+full-hopper MDR, the Beverloo-type coefficient C = MDR / (rho_b sqrt(g) b^1.5) with rho_b the
+outlet bulk density, and the MFI with the flow mode (mass flow if MFI > 0.3).
 
 For each cell size the thesis ch. 4 wedge hopper (with inflow) is written, run (1 s fill +
 `--discharge` s), and reduced with discharge.py / paths.py: steady MDR (regression of the
@@ -22,12 +28,12 @@ from .hopper_scene import hopper_scene
 from .paths import frames, outlet_path
 
 
-def run_case(exe, out, cell, discharge, shape):
+def run_case(exe, out, cell, discharge, shape, theta=30.0, outlet=0.25):
     out.mkdir(parents=True, exist_ok=True)
-    base = out / f"hopper_cell{cell:g}_{shape.lower()}"
+    base = out / f"hopper_cell{cell:g}_{shape.lower()}_theta{theta:g}_b{outlet:g}"
     scene = base.with_suffix(".inp")
     scene.write_text(hopper_scene(cell=cell, discharge_time=discharge, shape=shape, field_frames=5,
-                                  history_dt=0.01))
+                                  history_dt=0.01, theta=theta, outlet=outlet))
     t0 = time.perf_counter()
     r = subprocess.run([exe, str(scene), "--output", str(base), "--quiet"], capture_output=True, text=True)
     wall = time.perf_counter() - t0
@@ -38,10 +44,10 @@ def run_case(exe, out, cell, discharge, shape):
     npart = int(re.search(r"(\d+) particles,", r.stdout).group(1))
     hist = np.genfromtxt(str(base) + "_history.csv", delimiter=",", names=True)
     mdr = mean_discharge_rate(hist)
-    mfi, _, _ = mass_flow_index(str(base) + ".h5")
+    mfi, _, _ = mass_flow_index(str(base) + ".h5", theta, outlet)
     import h5py
     f = h5py.File(str(base) + ".h5", "r")
-    op = outlet_path(frames(f, 3), cell, 30.0, 0.25)
+    op = outlet_path(frames(f, 3), cell, theta, outlet)
     return dict(cell=cell, particles=npart, wall=wall, psteps=steps, mdr=mdr, mfi=mfi,
                 v_out=float(np.nanmean(op[:, 1])), rho_out=float(np.nanmean(op[:, 2])))
 
@@ -63,16 +69,35 @@ def convergence(a):
           "(last 3 frames); d*: relative to the reference")
 
 
+def sweep(a):
+    cases = [(30.0, b) for b in a.outlets] + [(t, 0.25) for t in a.thetas if t != 30.0]
+    print(f"wedge hopper sweep, cell {a.cell:g} m, {a.shape}, 1 s fill + {a.discharge:g} s discharge with inflow")
+    print(f"{'theta':>6} {'b m':>6} {'particles':>9} {'wall s':>7} {'MDR kg/s/m':>11} {'rho_out':>8} "
+          f"{'C':>6} {'MFI':>6}  mode")
+    for theta, b in cases:
+        r = run_case(a.bulkflow, Path(a.out), a.cell, a.discharge, a.shape, theta, b)
+        c = 2 * r["mdr"] / (r["rho_out"] * 9.81 ** 0.5 * b ** 1.5)
+        print(f"{theta:6.1f} {b:6.3f} {r['particles']:9d} {r['wall']:7.1f} {2 * r['mdr']:11.2f} "
+              f"{r['rho_out']:8.1f} {c:6.3f} {r['mfi']:6.3f}  {'mass flow' if r['mfi'] > 0.3 else 'funnel flow'}",
+              flush=True)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("study", choices=["convergence"])
+    p.add_argument("study", choices=["convergence", "sweep"])
+    p.add_argument("--outlets", type=float, nargs="+", default=[0.15, 0.25, 0.35])
+    p.add_argument("--thetas", type=float, nargs="+", default=[15.0, 30.0, 45.0])
+    p.add_argument("--cell", type=float, default=0.05)
     p.add_argument("--cells", type=float, nargs="+", default=[0.1, 0.07, 0.05])
     p.add_argument("--discharge", type=float, default=1.5)
     p.add_argument("--shape", choices=["GIMP", "LINEAR"], default="GIMP")
     p.add_argument("--out", default="out/mpm_study")
     p.add_argument("--bulkflow", default=str(Path(__file__).resolve().parents[3] / "build" / "bin" / "bulkflow"))
     a = p.parse_args(argv)
-    convergence(a)
+    if a.study == "convergence":
+        convergence(a)
+    else:
+        sweep(a)
     return 0
 
 
