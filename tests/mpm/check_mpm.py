@@ -54,10 +54,13 @@ def last_frame(base):
     return f["particles"][frames[-1]]
 
 
-def check_report(out, needed):
+def check_report(out, needed, absent=()):
     effects = next((l for l in out.splitlines() if l.strip().startswith("effects")), "")
     for e in needed:
         check(e in effects, f"effect '{e}' listed as active")
+    timing = out.split("timing (wall seconds):")[-1]
+    for e in absent:
+        check(e not in effects and e not in timing, f"unused effect '{e}' neither listed nor timed")
     check("timing (wall seconds)" in out and "p2g" in out.split("timing")[-1],
           "timing table lists the MPM phases")
 
@@ -70,7 +73,7 @@ def mass_balance(hist, exact_counts=None):
 
 def column(args):
     base, out, hist = run(args.bulkflow, args.scene, args.workdir)
-    check_report(out, ["p2g", "g2p", "material", "walls", "gravity", "damping"])
+    check_report(out, ["p2g", "g2p", "material", "walls", "gravity", "damping"], ["outflow", "inflow", "user field"])
     g = last_frame(base)
     x, s = g["coordinates"][:], g["S"][:]
     rho, grav, nu, height = 1600.0, 9.81, 0.2, 1.0
@@ -98,7 +101,7 @@ def column(args):
 
 def incline(args):
     base, out, hist = run(args.bulkflow, args.scene, args.workdir)
-    check_report(out, ["walls", "gravity"])
+    check_report(out, ["walls", "gravity"], ["damping", "outflow", "inflow"])
     a, mu, grav = math.radians(30.0), 0.2, 9.81
     t = hist["time"]
     vs = hist["VCM1"] * math.cos(a) - hist["VCM2"] * math.sin(a)
