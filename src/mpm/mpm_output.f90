@@ -8,7 +8,8 @@
 !>                                 LE (n, ncomp), density (n), mass (n), volume (n), id (n) int32,
 !>                                 material (n) int32 (1-based *MATERIAL order), SDV (n, nsdv)
 !>             /grid               attributes ndim, n (3), lo (3), h
-!>             /grid/NNNNNN        mass (nn), V (nn, 3) of the frame's increment (after walls)
+!>             /grid/NNNNNN        mass (nz, ny, nx), V (nz, ny, nx, 3) of the frame's increment
+!>                                 (nz = 1 in 2D), after the walls
 !>   BASE.xmf       particles: one Polyvertex grid per frame (temporal collection)
 !>   BASE_grid.xmf  background grid: CoRectMesh with nodal mass and V
 !>
@@ -147,8 +148,9 @@ contains
     gv = 0
     gv(1:nd, :) = g%v_new
     call h5gcreate_f(wr%file, 'grid/' // tag, grp, hdferr)
-    call write_r1(grp, 'mass', g%mass)
-    call write_r2(grp, 'V', gv)
+    ! shaped like the grid ((nz,) ny, nx[, 3] as h5py shows them) so the XDMF CoRectMesh reads them
+    call write_shaped(grp, 'mass', g%mass, [integer(hsize_t) :: g%n])
+    call write_shaped(grp, 'V', reshape(gv, [3 * g%nn]), [integer(hsize_t) :: 3, g%n])
     call h5gclose_f(grp, hdferr)
     call h5fflush_f(wr%file, H5F_SCOPE_GLOBAL_F, hdferr)
     wr%n_frames = wr%n_frames + 1
@@ -205,31 +207,21 @@ contains
     write (u, '(a)') '<?xml version="1.0" ?>'
     write (u, '(a)') '<Xdmf Version="3.0"><Domain>'
     write (u, '(a)') '<Grid Name="grid" GridType="Collection" CollectionType="Temporal">'
-    if (g%ndim == 2) then
-       write (gdims, '(i0,a,i0)') g%n(2), ' ', g%n(1)
-    else
-       write (gdims, '(i0,a,i0,a,i0)') g%n(3), ' ', g%n(2), ' ', g%n(1)
-    end if
+    ! 2D grids too as a 3D CoRectMesh one node thick (ParaView's XDMF reader then takes the
+    ! vector attribute; with 2DCoRectMesh it failed to read it)
+    write (gdims, '(i0,a,i0,a,i0)') g%n(3), ' ', g%n(2), ' ', g%n(1)
     do i = 1, wr%n_frames
        write (tag, '(i6.6)') i - 1
        write (u, '(a)') '<Grid Name="grid_' // tag // '" GridType="Uniform">'
        write (u, '(a,es24.16,a)') '<Time Value="', wr%times(i), '"/>'
-       if (g%ndim == 2) then
-          write (u, '(a)') '<Topology TopologyType="2DCoRectMesh" Dimensions="' // trim(gdims) // '"/>'
-          write (u, '(a)') '<Geometry GeometryType="ORIGIN_DXDY">'
-          write (u, '(a,2es24.16,a)') '<DataItem Dimensions="2" Format="XML">', g%lo(2), g%lo(1), '</DataItem>'
-          write (u, '(a,2es24.16,a)') '<DataItem Dimensions="2" Format="XML">', g%h, g%h, '</DataItem>'
-       else
-          write (u, '(a)') '<Topology TopologyType="3DCoRectMesh" Dimensions="' // trim(gdims) // '"/>'
-          write (u, '(a)') '<Geometry GeometryType="ORIGIN_DXDYDZ">'
-          write (u, '(a,3es24.16,a)') '<DataItem Dimensions="3" Format="XML">', g%lo(3), g%lo(2), g%lo(1), &
-               '</DataItem>'
-          write (u, '(a,3es24.16,a)') '<DataItem Dimensions="3" Format="XML">', g%h, g%h, g%h, '</DataItem>'
-       end if
+       write (u, '(a)') '<Topology TopologyType="3DCoRectMesh" Dimensions="' // trim(gdims) // '"/>'
+       write (u, '(a)') '<Geometry GeometryType="ORIGIN_DXDYDZ">'
+       write (u, '(a,3es24.16,a)') '<DataItem Dimensions="3" Format="XML">', g%lo(3), g%lo(2), g%lo(1), &
+            '</DataItem>'
+       write (u, '(a,3es24.16,a)') '<DataItem Dimensions="3" Format="XML">', g%h, g%h, g%h, '</DataItem>'
        write (u, '(a)') '</Geometry>'
-       write (dims, '(i0)') g%nn
-       call attribute(u, 'mass', 'Scalar', trim(dims), h5 // ':/grid/' // tag // '/mass', 'Node')
-       call attribute(u, 'V', 'Vector', trim(dims) // ' 3', h5 // ':/grid/' // tag // '/V', 'Node')
+       call attribute(u, 'mass', 'Scalar', trim(gdims), h5 // ':/grid/' // tag // '/mass', 'Node')
+       call attribute(u, 'V', 'Vector', trim(gdims) // ' 3', h5 // ':/grid/' // tag // '/V', 'Node')
        write (u, '(a)') '</Grid>'
     end do
     write (u, '(a)') '</Grid></Domain></Xdmf>'
@@ -264,6 +256,23 @@ contains
     call h5dclose_f(dset, hdferr)
     call h5sclose_f(space, hdferr)
   end subroutine write_r2
+
+  !> A flat buffer written as a dataset of Fortran shape dims (h5py shows it reversed).
+  subroutine write_shaped(loc, name, a, dims)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: a(:)
+    integer(hsize_t), intent(in) :: dims(:)
+    integer(hid_t) :: space, dset
+    integer :: hdferr
+    call h5screate_simple_f(size(dims), dims, space, hdferr)
+    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, hdferr)
+    call check(hdferr, 'creating dataset ' // name)
+    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, a, dims, hdferr)
+    call check(hdferr, 'writing dataset ' // name)
+    call h5dclose_f(dset, hdferr)
+    call h5sclose_f(space, hdferr)
+  end subroutine write_shaped
 
   subroutine write_r1(loc, name, a)
     integer(hid_t), intent(in) :: loc

@@ -71,6 +71,29 @@ def mass_balance(hist, exact_counts=None):
     check(err <= 1e-12 * m0, f"mass balance: max |M0 + Min - Mout - M| = {err:.3e} kg (M0 = {m0:.6g} kg)")
 
 
+def paraview_check(base, n_particles):
+    """With pvpython on PATH: ParaView opens BASE.xmf (particles) and BASE_grid.xmf (grid)."""
+    import shutil
+    pv = shutil.which("pvpython")
+    if pv is None:
+        print("      (pvpython not found: ParaView check skipped)")
+        return
+    script = f"""
+from paraview.simple import XDMFReader, servermanager
+for f in ['{base}.xmf', '{base}_grid.xmf']:
+    r = XDMFReader(FileNames=[f])
+    r.UpdatePipeline(r.TimestepValues[-1])
+    d = servermanager.Fetch(r)
+    pd = d.GetPointData()
+    print('PV', f, d.GetNumberOfPoints(), sorted(pd.GetArrayName(i) for i in range(pd.GetNumberOfArrays())))
+"""
+    r = subprocess.run([pv, "-c", script], capture_output=True, text=True, timeout=120)
+    lines = [l.split(" ", 2) for l in r.stdout.splitlines() if l.startswith("PV ")]
+    check(len(lines) == 2 and "Error" not in r.stdout + r.stderr, "ParaView reads the particle and grid XDMF files")
+    check(int(lines[0][2].split(" ")[0]) == n_particles and "'S'" in lines[0][2] and "'V'" in lines[1][2],
+          f"ParaView: {n_particles} particles with S and V, grid with V")
+
+
 def column(args):
     base, out, hist = run(args.bulkflow, args.scene, args.workdir)
     check_report(out, ["p2g", "g2p", "material", "walls", "gravity", "damping"], ["outflow", "inflow", "user field"])
@@ -97,6 +120,7 @@ def column(args):
     check(worst_s < 0.02, f"sigma_yy vs -rho g (H - y): max relative error {worst_s:.2e}")
     check(hist["ALLKE"][-1] < 1e-6 * max(hist["ALLIE"][-1], 1e-30), "column at rest (ALLKE << ALLIE)")
     mass_balance(hist)
+    paraview_check(base, len(x))
 
 
 def incline(args):
