@@ -123,24 +123,20 @@ contains
     error stop 2, quiet=.true.
   end subroutine input_error_exit
 
-  !> A material-point scene: one rank (MPI for MPM is not implemented yet), no restart.
+  !> A material-point scene (particle decomposition over the ranks, src/mpm/mpm_run.f90); no restart.
   subroutine run_mpm(m, opts)
     type(model_t), intent(in) :: m
     type(run_options_t), intent(in) :: opts
     type(error_t) :: e
 
     e%raised = .false.
-    if (nranks > 1) then
-       e%message = trim(m%input_file) // ': material-point scenes run on one rank (MPI for MPM is ' // &
-            'not implemented yet); expected bulkflow without mpirun, or mpirun -np 1'
-       e%raised = .true.
-    else if (opts%restart .or. any(m%steps(1:m%n_steps)%restart_write)) then
+    if (opts%restart .or. any(m%steps(1:m%n_steps)%restart_write)) then
        e%message = trim(m%input_file) // ': restart is not available for material-point scenes yet; ' // &
             'expected no --restart and no *RESTART, WRITE'
        e%raised = .true.
     end if
     if (e%raised) call input_error_exit(e)
-    call mpm_run_scene(m, opts%output_base, opts%progress, opts%stop_after)
+    call mpm_run_scene(m, opts%output_base, opts%progress, opts%stop_after, MPI_COMM_WORLD)
   end subroutine run_mpm
 
   subroutine abort_all()

@@ -15,10 +15,17 @@
 !> Why Green–Naghdi and not Jaumann/Hughes–Winget: the VUMAT contract (and our elements) hand
 !> the material stresses in the frame R of F = RU; a particle carries F, so the same frame, the
 !> same relSpinInc and the same code serve both (a user VUMAT sees one convention).
-!> MPI: this driver runs on one rank; bulkflow refuses more ranks for an MPM scene.
+!> MPI: particle decomposition with a replicated grid. Every rank generates all particles and
+!> keeps every nranks-th block; P2G sums (mass, momentum, forces) and the MUSL remap are summed
+!> over ranks (one MPI_Allreduce each), so every rank holds the whole grid and does the grid
+!> update and the walls itself; particles never migrate. Inflow particles are made by rank 0.
+!> Sums over ranks are in rank order (MPI_Allreduce): results are deterministic for a given
+!> number of ranks and differ from 1 rank by round-off only. Output: rank 0 gathers the blocks.
 module mpm_run
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
-  use mpi_f08, only: MPI_COMM_SELF
+  use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_IN_PLACE, &
+       MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_INTEGER8, MPI_LOGICAL, MPI_SUM, MPI_MAX, MPI_LOR, MPI_MAXLOC, &
+       MPI_2DOUBLE_PRECISION, MPI_Send, MPI_Recv, MPI_STATUS_IGNORE
   use material_kinds, only: dp
   use error_report, only: raise_error
   use material_props, only: model_from_name, model_unknown
@@ -51,8 +58,11 @@ module mpm_run
      type(timer_set_t) :: timers
   end type mpm_effects_t
 
-  !> Everything the run keeps.
+  !> Everything the run keeps. Per-rank partial values (sum over ranks when reported) are
+  !> marked "rank"; the rest is the same on every rank.
   type :: mpm_state_t
+     type(MPI_Comm) :: comm
+     integer :: rank = 0, nranks = 1
      integer :: nd = 0, nc = 0, nshr = 0, ns = 0
      type(grid_t) :: g
      integer :: nblocks = 0
@@ -63,12 +73,12 @@ module mpm_run
      type(vumat_work_t) :: work
      integer :: next_number = 0
      ! mass bookkeeping (exact: particle masses never change)
-     real(dp) :: mass_initial = 0, mass_in = 0, mass_out = 0
-     integer :: n_in = 0, n_out = 0, n_guarded = 0
+     real(dp) :: mass_initial = 0, mass_in = 0, mass_out = 0   !< mass_out: rank
+     integer :: n_initial = 0, n_in = 0, n_out = 0, n_guarded = 0  !< n_out, n_guarded: rank
      real(dp) :: mass_cutoff = 0
      ! energies (global sums; 2D per unit thickness)
      real(dp) :: e_kinetic = 0, e_internal = 0, w_external = 0, e_walls = 0, e_damping = 0
-     real(dp) :: e_out = 0, e_in = 0
+     real(dp) :: e_out = 0, e_in = 0                 !< w_external, e_out: rank (e_kinetic, e_internal: global after measure)
      real(dp), allocatable :: wall_force(:, :)       !< (3, n_walls) force of the material on each wall
      logical, allocatable :: on_wall(:)              !< grid nodes of the walls active in this step
      ! time
@@ -84,11 +94,12 @@ module mpm_run
 contains
 
   !> Run a material-point scene: base = output path without extension.
-  subroutine mpm_run_scene(m, base, progress, stop_after)
+  subroutine mpm_run_scene(m, base, progress, stop_after, comm)
     type(model_t), intent(in) :: m
     character(len=*), intent(in) :: base
     logical, intent(in) :: progress
     integer, intent(in) :: stop_after
+    type(MPI_Comm), intent(in) :: comm
     type(mpm_state_t) :: st
     type(mpm_effects_t) :: fx
     type(mpm_writer_t) :: wr
@@ -100,17 +111,20 @@ contains
     integer(int64) :: clock_last, clock_now, clock_rate, clock_start
     logical :: stop_now
 
+    st%comm = comm
+    call MPI_Comm_rank(comm, st%rank)
+    call MPI_Comm_size(comm, st%nranks)
     call setup(m, st, fx)
     nsdv = 0
     do k = 1, m%n_materials
        nsdv = max(nsdv, m%materials(k)%nstatev)
     end do
-    call header(m, st, fx, base)
-    call mpm_writer_open(wr, base, st%g, st%nc, nsdv)
+    if (st%rank == 0) call header(m, st, fx, base)
+    if (st%rank == 0) call mpm_writer_open(wr, base, st%g, st%nc, nsdv)
     call history_columns(m, columns)
-    call history_open(hist, base // '_history.csv', columns, MPI_COMM_SELF)
+    call history_open(hist, base // '_history.csv', columns, comm)
     call measure(st)
-    call mpm_writer_frame(wr, st%blocks, st%nblocks, st%g, 1, 0, 0.0_dp, 0.0_dp)
+    call write_frame(st, wr, 1, 0.0_dp)
     last_row_time = 0
     last_row_out = 0
     call write_history(m, st, hist, last_row_time, last_row_out)
@@ -146,18 +160,18 @@ contains
           end if
           if (st%step_time >= next_field - eps .or. (st%step_time >= period - eps .and. field_dt < huge(1.0_dp)) &
                .or. stop_now) then
-             call mpm_writer_frame(wr, st%blocks, st%nblocks, st%g, s, st%increment, st%step_time, st%total_time)
+             call write_frame(st, wr, s, st%step_time)
              do while (next_field <= st%step_time + eps)
                 next_field = next_field + field_dt
              end do
           end if
-          if (progress) then
+          if (progress .and. st%rank == 0) then
+             ! rank 0's own clock decides: no collective here (the ranks' clocks differ)
              call system_clock(clock_now)
              if (real(clock_now - clock_last, dp) / real(clock_rate, dp) > 2.0_dp) then
                 clock_last = clock_now
-                write (output_unit, '(a,i0,a,es11.4,a,i0,a,i0,a,es10.3,a,es11.4)') '  step ', s, '  t = ', &
-                     st%total_time, '  inc ', st%increment, '  particles ', sum(st%blocks(1:st%nblocks)%count), &
-                     '  dt ', st%dt, '  out kg ', st%mass_out
+                write (output_unit, '(a,i0,a,es11.4,a,i0,a,es10.3,a,es11.4)') '  step ', s, '  t = ', &
+                     st%total_time, '  inc ', st%increment, '  dt ', st%dt, '  out kg (rank 0) ', st%mass_out
                 flush (output_unit)
              end if
           end if
@@ -168,10 +182,120 @@ contains
     end do
     call system_clock(clock_now)
     st%loop_seconds = real(clock_now - clock_start, dp) / real(clock_rate, dp)
-    call mpm_writer_close(wr)
+    if (st%rank == 0) call mpm_writer_close(wr)
     call history_close(hist)
     call summary(m, st, fx, stop_now)
   end subroutine mpm_run_scene
+
+  ! ------------------------------------------------------------------------------ ranks
+
+  subroutine sum_real(st, x)
+    type(mpm_state_t), intent(in) :: st
+    real(dp), intent(inout) :: x(:)
+    if (st%nranks > 1) call MPI_Allreduce(MPI_IN_PLACE, x, size(x), MPI_DOUBLE_PRECISION, MPI_SUM, st%comm)
+  end subroutine sum_real
+
+  subroutine max_real(st, x)
+    type(mpm_state_t), intent(in) :: st
+    real(dp), intent(inout) :: x(:)
+    if (st%nranks > 1) call MPI_Allreduce(MPI_IN_PLACE, x, size(x), MPI_DOUBLE_PRECISION, MPI_MAX, st%comm)
+  end subroutine max_real
+
+  integer function global_count(st)
+    type(mpm_state_t), intent(in) :: st
+    integer :: n(1)
+    n(1) = sum(st%blocks(1:st%nblocks)%count)
+    if (st%nranks > 1) call MPI_Allreduce(MPI_IN_PLACE, n, 1, MPI_INTEGER, MPI_SUM, st%comm)
+    global_count = n(1)
+  end function global_count
+
+  !> A field frame: rank 0 gathers every rank's blocks (in rank order) and writes them.
+  subroutine write_frame(st, wr, step, step_time)
+    type(mpm_state_t), intent(inout) :: st
+    type(mpm_writer_t), intent(inout) :: wr
+    integer, intent(in) :: step
+    real(dp), intent(in) :: step_time
+    type(particle_block_t), allocatable :: all(:)
+    integer :: nall
+
+    if (st%nranks == 1) then
+       call mpm_writer_frame(wr, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time)
+       return
+    end if
+    call gather_blocks(st, all, nall)
+    if (st%rank == 0) call mpm_writer_frame(wr, all, nall, st%g, step, st%increment, step_time, st%total_time)
+  end subroutine write_frame
+
+  !> Rank 0 receives copies of the other ranks' blocks (what the writer reads of them).
+  subroutine gather_blocks(st, all, nall)
+    type(mpm_state_t), intent(in) :: st
+    type(particle_block_t), allocatable, intent(out) :: all(:)
+    integer, intent(out) :: nall
+    integer :: r, k, nb(1), head(5), c, nd, nc, nsv, nfv, nreal, off
+    real(dp), allocatable :: buf(:)
+
+    nd = st%nd
+    nc = st%nc
+    nall = 0
+    if (st%rank /= 0) then
+       allocate (all(0))
+       nb(1) = st%nblocks
+       call MPI_Send(nb, 1, MPI_INTEGER, 0, 1, st%comm)
+       do k = 1, st%nblocks
+          associate (b => st%blocks(k))
+            c = b%count
+            head = [c, b%material, size(b%state, 2), size(b%field, 2), 0]
+            call MPI_Send(head, 5, MPI_INTEGER, 0, 2, st%comm)
+            call MPI_Send(b%number, c, MPI_INTEGER, 0, 3, st%comm)
+            buf = [reshape(b%x, [c * nd]), reshape(b%v, [c * nd]), reshape(b%stress_global, [c * nc]), &
+                 reshape(b%log_strain, [c * nc]), reshape(b%f, [c * nd * nd]), b%vol0, b%mass, &
+                 reshape(b%state, [size(b%state)]), b%half]
+            call MPI_Send(buf, size(buf), MPI_DOUBLE_PRECISION, 0, 4, st%comm)
+          end associate
+       end do
+       return
+    end if
+    allocate (all(st%nblocks + 16))
+    all(1:st%nblocks) = st%blocks(1:st%nblocks)
+    nall = st%nblocks
+    do r = 1, st%nranks - 1
+       call MPI_Recv(nb, 1, MPI_INTEGER, r, 1, st%comm, MPI_STATUS_IGNORE)
+       do k = 1, nb(1)
+          call MPI_Recv(head, 5, MPI_INTEGER, r, 2, st%comm, MPI_STATUS_IGNORE)
+          c = head(1)
+          nsv = head(3)
+          nfv = head(4)
+          if (nall == size(all)) call grow_list(all, nall)
+          nall = nall + 1
+          call block_allocate(all(nall), c, nd, nc, nsv, nfv, 1)
+          all(nall)%material = head(2)
+          call MPI_Recv(all(nall)%number, c, MPI_INTEGER, r, 3, st%comm, MPI_STATUS_IGNORE)
+          nreal = c * (2 * nd + 2 * nc + nd * nd + 2 + nsv) + 1
+          if (allocated(buf)) deallocate (buf)
+          allocate (buf(nreal))
+          call MPI_Recv(buf, nreal, MPI_DOUBLE_PRECISION, r, 4, st%comm, MPI_STATUS_IGNORE)
+          off = 0
+          all(nall)%x = reshape(buf(off + 1:off + c * nd), [c, nd]); off = off + c * nd
+          all(nall)%v = reshape(buf(off + 1:off + c * nd), [c, nd]); off = off + c * nd
+          all(nall)%stress_global = reshape(buf(off + 1:off + c * nc), [c, nc]); off = off + c * nc
+          all(nall)%log_strain = reshape(buf(off + 1:off + c * nc), [c, nc]); off = off + c * nc
+          all(nall)%f = reshape(buf(off + 1:off + c * nd * nd), [c, nd, nd]); off = off + c * nd * nd
+          all(nall)%vol0 = buf(off + 1:off + c); off = off + c
+          all(nall)%mass = buf(off + 1:off + c); off = off + c
+          all(nall)%state = reshape(buf(off + 1:off + c * nsv), [c, nsv]); off = off + c * nsv
+          all(nall)%half = buf(off + 1)
+       end do
+    end do
+  end subroutine gather_blocks
+
+  subroutine grow_list(list, n)
+    type(particle_block_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(particle_block_t), allocatable :: grown(:)
+    allocate (grown(2 * n + 16))
+    grown(1:n) = list(1:n)
+    call move_alloc(grown, list)
+  end subroutine grow_list
 
   ! ------------------------------------------------------------------------------ set-up
 
@@ -225,6 +349,17 @@ contains
          st%mass_initial = st%mass_initial + sum(st%blocks(k)%mass)
       end do
       st%mass_cutoff = 1.0e-9_dp * maxval([(maxval(st%blocks(k)%mass), k = 1, st%nblocks)])
+      st%n_initial = sum(st%blocks(1:st%nblocks)%count)
+      ! every rank made all blocks (same order); each keeps every nranks-th one
+      if (st%nranks > 1) then
+         s = 0
+         do k = 1, st%nblocks
+            if (mod(k - 1, st%nranks) /= st%rank) cycle
+            s = s + 1
+            if (s /= k) st%blocks(s) = st%blocks(k)
+         end do
+         st%nblocks = s
+      end if
       allocate (st%wall_nodes(size(mpm%walls)), st%wall_force(3, size(mpm%walls)))
       st%wall_force = 0
       do k = 1, size(mpm%walls)
@@ -374,7 +509,7 @@ contains
   subroutine stable_increment(m, st)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    real(dp) :: speed, vmax, rho, detf
+    real(dp) :: speed, vmax, rho, detf, v1(1)
     integer :: ib, p
 
     vmax = 0
@@ -388,7 +523,9 @@ contains
          end do
        end associate
     end do
-    st%dt_stable = m%mpm%steps(st%step)%cfl * m%mpm%cell / max(vmax, tiny(1.0_dp))
+    v1(1) = vmax
+    call max_real(st, v1)
+    st%dt_stable = m%mpm%steps(st%step)%cfl * m%mpm%cell / max(v1(1), tiny(1.0_dp))
   end subroutine stable_increment
 
   !> The nodes the active walls constrain: local damping leaves them alone, so that it does not
@@ -448,6 +585,7 @@ contains
        call stencil(m, st, st%blocks(ib))
        call p2g(st, st%blocks(ib))
     end do
+    if (st%nranks > 1) call reduce_grid(st, .true.)
     call timer_stop(fx%timers, fx%id(fx_p2g))
 
     ! grid update
@@ -471,6 +609,7 @@ contains
     do ib = 1, st%nblocks
        call g2p(m, st, st%blocks(ib))
     end do
+    if (st%nranks > 1) call reduce_grid(st, .false.)
     do i = 1, st%g%nn
        if (st%g%active(i)) then
           st%g%v_new(:, i) = st%g%mom(:, i) / st%g%mass(i)
@@ -511,6 +650,26 @@ contains
        end if
     end if
   end subroutine increment
+
+  !> Sum the grid arrays over ranks: after P2G mass, momentum and force, after the remap momentum.
+  subroutine reduce_grid(st, all_fields)
+    type(mpm_state_t), intent(inout) :: st
+    logical, intent(in) :: all_fields
+    real(dp), allocatable :: buf(:)
+    integer :: nn, nd
+
+    nn = st%g%nn
+    nd = st%nd
+    if (all_fields) then
+       buf = [st%g%mass, reshape(st%g%mom, [nd * nn]), reshape(st%g%force, [nd * nn])]
+       call MPI_Allreduce(MPI_IN_PLACE, buf, size(buf), MPI_DOUBLE_PRECISION, MPI_SUM, st%comm)
+       st%g%mass = buf(1:nn)
+       st%g%mom = reshape(buf(nn + 1:nn + nd * nn), [nd, nn])
+       st%g%force = reshape(buf(nn + nd * nn + 1:), [nd, nn])
+    else
+       call MPI_Allreduce(MPI_IN_PLACE, st%g%mom, nd * nn, MPI_DOUBLE_PRECISION, MPI_SUM, st%comm)
+    end if
+  end subroutine reduce_grid
 
   subroutine stencil(m, st, b)
     type(model_t), intent(in) :: m
@@ -932,6 +1091,7 @@ contains
          end do
        end associate
     end do
+    if (st%nranks > 1) call global_tops(st, ncol, seen, top, vtop)
     n = 0
     v = 0
     do jc = 0, nc(3) - 1
@@ -951,11 +1111,36 @@ contains
     if (n == 0) return
     ! the column's top velocity, averaged over the new layer (avoids an impact on arrival)
     v = v / n
-    call add_particles(m, st, q%material, q%ppc, pts(:, 1:n), v)
+    ! every rank found the same layer; rank 0 owns the new particles
+    if (st%rank == 0) call add_particles(m, st, q%material, q%ppc, pts(:, 1:n), v)
     st%mass_in = st%mass_in + n * m%materials(q%material)%density * dx**nd
     st%n_in = st%n_in + n
     st%e_in = st%e_in + 0.5_dp * n * m%materials(q%material)%density * dx**nd * sum(v**2)
   end subroutine inflow
+
+  !> The highest particle of every inflow column over all ranks and its velocity (the lowest
+  !> rank wins a tie, so exactly one rank supplies it).
+  subroutine global_tops(st, ncol, seen, top, vtop)
+    type(mpm_state_t), intent(in) :: st
+    integer, intent(in) :: ncol
+    logical, intent(inout) :: seen(ncol)
+    real(dp), intent(inout) :: top(ncol), vtop(3, ncol)
+    real(dp) :: pair(2, ncol)
+    integer :: c
+
+    do c = 1, ncol
+       pair(1, c) = -huge(1.0_dp)
+       if (seen(c)) pair(1, c) = top(c)
+       pair(2, c) = real(st%rank, dp)
+    end do
+    call MPI_Allreduce(MPI_IN_PLACE, pair, ncol, MPI_2DOUBLE_PRECISION, MPI_MAXLOC, st%comm)
+    call MPI_Allreduce(MPI_IN_PLACE, seen, ncol, MPI_LOGICAL, MPI_LOR, st%comm)
+    do c = 1, ncol
+       if (nint(pair(2, c)) /= st%rank) vtop(:, c) = 0
+       top(c) = pair(1, c)
+    end do
+    call MPI_Allreduce(MPI_IN_PLACE, vtop, 3 * ncol, MPI_DOUBLE_PRECISION, MPI_SUM, st%comm)
+  end subroutine global_tops
 
   ! ------------------------------------------------------------------------------ output
 
@@ -1015,6 +1200,7 @@ contains
   subroutine measure(st)
     type(mpm_state_t), intent(inout) :: st
     integer :: ib
+    real(dp) :: e(2)
     st%e_kinetic = 0
     st%e_internal = 0
     do ib = 1, st%nblocks
@@ -1023,42 +1209,52 @@ contains
          st%e_internal = st%e_internal + sum(b%mass * b%e_int)
        end associate
     end do
+    e = [st%e_kinetic, st%e_internal]
+    call sum_real(st, e)
+    st%e_kinetic = e(1)
+    st%e_internal = e(2)
   end subroutine measure
 
+  !> One history row: global values (sums over ranks in rank order; collective).
   subroutine write_history(m, st, hist, last_time, last_out)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(in) :: st
     type(history_t), intent(inout) :: hist
     real(dp), intent(inout) :: last_time, last_out
     real(dp), allocatable :: row(:)
-    real(dp) :: mass, xcm(3), vcm(3), ytop, mdr, etotal
-    integer :: ib, k, n, j
+    real(dp) :: g(12), top(1), mass, xcm(3), vcm(3), mdr, etotal, mass_out
+    integer :: ib, k, j
 
-    mass = 0
-    xcm = 0
-    vcm = 0
-    ytop = -huge(1.0_dp)
-    n = 0
+    g = 0
+    top = -huge(1.0_dp)
     do ib = 1, st%nblocks
        associate (b => st%blocks(ib))
-         mass = mass + sum(b%mass)
+         g(1) = g(1) + sum(b%mass)
          do k = 1, st%nd
-            xcm(k) = xcm(k) + sum(b%mass * b%x(:, k))
-            vcm(k) = vcm(k) + sum(b%mass * b%v(:, k))
+            g(1 + k) = g(1 + k) + sum(b%mass * b%x(:, k))
+            g(4 + k) = g(4 + k) + sum(b%mass * b%v(:, k))
          end do
-         ytop = max(ytop, maxval(b%x(:, 2)))
-         n = n + b%count
+         top(1) = max(top(1), maxval(b%x(:, 2)))
+         g(8) = g(8) + b%count
        end associate
     end do
-    xcm = xcm / mass
-    vcm = vcm / mass
+    g(9) = st%mass_out
+    g(10) = st%w_external
+    g(11) = st%e_out
+    g(12) = st%n_guarded
+    call sum_real(st, g)
+    call max_real(st, top)
+    mass = g(1)
+    xcm = g(2:4) / mass
+    vcm = g(5:7) / mass
+    mass_out = g(9)
     mdr = 0
-    if (st%total_time > last_time) mdr = (st%mass_out - last_out) / (st%total_time - last_time)
-    etotal = st%e_kinetic + st%e_internal + st%e_walls + st%e_damping + st%e_out - st%e_in - st%w_external
+    if (st%total_time > last_time) mdr = (mass_out - last_out) / (st%total_time - last_time)
+    etotal = st%e_kinetic + st%e_internal + st%e_walls + st%e_damping + g(11) - st%e_in - g(10)
     allocate (row(24 + 3 * size(m%mpm%walls)))
-    row(1:24) = [st%total_time, real(st%step, dp), st%step_time, real(st%increment, dp), real(n, dp), mass, &
-         st%mass_in, st%mass_out, mdr, st%mass_initial + st%mass_in - st%mass_out - mass, st%e_kinetic, &
-         st%e_internal, st%w_external, st%e_walls, st%e_damping, etotal, xcm, vcm, ytop, real(st%n_guarded, dp)]
+    row(1:24) = [st%total_time, real(st%step, dp), st%step_time, real(st%increment, dp), g(8), mass, &
+         st%mass_in, mass_out, mdr, st%mass_initial + st%mass_in - mass_out - mass, st%e_kinetic, &
+         st%e_internal, g(10), st%e_walls, st%e_damping, etotal, xcm, vcm, top(1), g(12)]
     j = 24
     do k = 1, size(m%mpm%walls)
        row(j + 1:j + 3) = st%wall_force(:, k)
@@ -1066,7 +1262,7 @@ contains
     end do
     call history_row(hist, row)
     last_time = st%total_time
-    last_out = st%mass_out
+    last_out = mass_out
   end subroutine write_history
 
   subroutine header(m, st, fx, base)
@@ -1084,9 +1280,9 @@ contains
        list = list // trim(fx_names(k))
     end do
     write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
-    write (output_unit, '(a,i0,a,i0,a,i0,a,es10.3,a,a)') '  mpm       ', st%nd, 'D, ', &
-         sum(st%blocks(1:st%nblocks)%count), ' particles, ', st%g%nn, ' grid nodes, cell ', m%mpm%cell, &
-         ', shape ', trim(merge('uGIMP ', 'linear', st%ns == 3**st%nd))
+    write (output_unit, '(a,i0,a,i0,a,i0,a,es10.3,a,a,a,i0,a)') '  mpm       ', st%nd, 'D, ', &
+         st%n_initial, ' particles, ', st%g%nn, ' grid nodes, cell ', m%mpm%cell, &
+         ', shape ', trim(merge('uGIMP ', 'linear', st%ns == 3**st%nd)), ', ', st%nranks, ' rank(s)'
     write (output_unit, '(a)') '  effects   ' // list
     write (output_unit, '(a)') '  output    ' // base // '.h5/.xmf (particles), ' // base // '_grid.xmf, ' // &
          base // '_history.csv'
@@ -1098,29 +1294,34 @@ contains
     type(mpm_state_t), intent(inout) :: st
     type(mpm_effects_t), intent(in) :: fx
     logical, intent(in) :: stopped
-    real(dp) :: mass
-    integer :: ib, k, n
+    real(dp) :: g(8), rate
+    integer :: ib, k
 
     call measure(st)
-    mass = 0
-    n = 0
+    g = 0
     do ib = 1, st%nblocks
-       mass = mass + sum(st%blocks(ib)%mass)
-       n = n + st%blocks(ib)%count
+       g(1) = g(1) + sum(st%blocks(ib)%mass)
+       g(2) = g(2) + st%blocks(ib)%count
     end do
+    g(3:8) = [st%mass_out, real(st%n_out, dp), st%w_external, real(st%n_guarded, dp), &
+         real(st%particle_steps, dp), 0.0_dp]
+    call sum_real(st, g)
+    call timer_report(fx%timers, output_unit, st%comm)
+    if (st%rank /= 0) return
     if (stopped) write (output_unit, '(a,i0)') 'bulkflow: stopped after increment ', st%increment
     write (output_unit, '(a,i0,a,es12.5)') 'bulkflow: done, ', st%increment, ' increments, t = ', st%total_time
-    write (output_unit, '(a,i0,a,i0,a,i0,a)') '  particles ', n, ' (', st%n_in, ' in, ', st%n_out, ' out)'
+    write (output_unit, '(a,i0,a,i0,a,i0,a)') '  particles ', nint(g(2)), ' (', st%n_in, ' in, ', nint(g(4)), ' out)'
     write (output_unit, '(a,4es14.6,a,es10.2)') '  mass      initial, in, out, now:', st%mass_initial, st%mass_in, &
-         st%mass_out, mass, '  balance error', st%mass_initial + st%mass_in - st%mass_out - mass
+         g(3), g(1), '  balance error', st%mass_initial + st%mass_in - g(3) - g(1)
     write (output_unit, '(a,5es12.4)') '  energies  ALLKE ALLIE ALLWK ALLFD ALLDMD:', st%e_kinetic, st%e_internal, &
-         st%w_external, st%e_walls, st%e_damping
+         g(5), st%e_walls, st%e_damping
     do k = 1, size(m%mpm%walls)
        write (output_unit, '(a,3es13.5)') '  wall ' // trim(m%mpm%walls(k)%name) // ' force:', st%wall_force(:, k)
     end do
-    if (st%n_guarded > 0) write (output_unit, '(a,i0)') '  particles put back onto walls: ', st%n_guarded
-    write (output_unit, '(a,i0,a,es11.4,a,f10.3,a)') '  throughput ', st%particle_steps, ' particle-steps, ', &
-         real(st%particle_steps, dp) / max(st%loop_seconds, 1.0e-9_dp), ' per second (time loop ', st%loop_seconds, ' s)'
-    call timer_report(fx%timers, output_unit)
+    if (g(6) > 0) write (output_unit, '(a,i0)') '  particles put back onto walls: ', nint(g(6))
+    rate = g(7) / max(st%loop_seconds, 1.0e-9_dp)
+    write (output_unit, '(a,i0,a,es11.4,a,f10.3,a,i0,a,es11.4,a)') '  throughput ', nint(g(7), int64), &
+         ' particle-steps, ', rate, ' per second (time loop ', st%loop_seconds, ' s, ', st%nranks, &
+         ' ranks: ', rate / st%nranks, ' per rank)'
   end subroutine summary
 end module mpm_run
