@@ -222,6 +222,7 @@ contains
        call mpm_writer_frame(wr, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time)
        return
     end if
+    allocate (all(st%nblocks + 16))
     call gather_blocks(st, all, nall)
     if (st%rank == 0) call mpm_writer_frame(wr, all, nall, st%g, step, st%increment, step_time, st%total_time)
   end subroutine write_frame
@@ -229,7 +230,7 @@ contains
   !> Rank 0 receives copies of the other ranks' blocks (what the writer reads of them).
   subroutine gather_blocks(st, all, nall)
     type(mpm_state_t), intent(in) :: st
-    type(particle_block_t), allocatable, intent(out) :: all(:)
+    type(particle_block_t), allocatable, intent(inout) :: all(:)   !< allocated by the caller
     integer, intent(out) :: nall
     integer :: r, k, nb(1), head(5), c, nd, nc, nsv, nfv, nreal, off
     real(dp), allocatable :: buf(:)
@@ -238,7 +239,6 @@ contains
     nc = st%nc
     nall = 0
     if (st%rank /= 0) then
-       allocate (all(0))
        nb(1) = st%nblocks
        call MPI_Send(nb, 1, MPI_INTEGER, 0, 1, st%comm)
        do k = 1, st%nblocks
@@ -247,15 +247,24 @@ contains
             head = [c, b%material, size(b%state, 2), size(b%field, 2), 0]
             call MPI_Send(head, 5, MPI_INTEGER, 0, 2, st%comm)
             call MPI_Send(b%number, c, MPI_INTEGER, 0, 3, st%comm)
-            buf = [reshape(b%x, [c * nd]), reshape(b%v, [c * nd]), reshape(b%stress_global, [c * nc]), &
-                 reshape(b%log_strain, [c * nc]), reshape(b%f, [c * nd * nd]), b%vol0, b%mass, &
-                 reshape(b%state, [size(b%state)]), b%half]
+            nsv = size(b%state, 2)
+            if (allocated(buf)) deallocate (buf)
+            allocate (buf(c * (2 * nd + 2 * nc + nd * nd + 2 + nsv) + 1))
+            off = 0
+            buf(off + 1:off + c * nd) = reshape(b%x, [c * nd]); off = off + c * nd
+            buf(off + 1:off + c * nd) = reshape(b%v, [c * nd]); off = off + c * nd
+            buf(off + 1:off + c * nc) = reshape(b%stress_global, [c * nc]); off = off + c * nc
+            buf(off + 1:off + c * nc) = reshape(b%log_strain, [c * nc]); off = off + c * nc
+            buf(off + 1:off + c * nd * nd) = reshape(b%f, [c * nd * nd]); off = off + c * nd * nd
+            buf(off + 1:off + c) = b%vol0; off = off + c
+            buf(off + 1:off + c) = b%mass; off = off + c
+            buf(off + 1:off + c * nsv) = reshape(b%state, [c * nsv]); off = off + c * nsv
+            buf(off + 1) = b%half
             call MPI_Send(buf, size(buf), MPI_DOUBLE_PRECISION, 0, 4, st%comm)
           end associate
        end do
        return
     end if
-    allocate (all(st%nblocks + 16))
     all(1:st%nblocks) = st%blocks(1:st%nblocks)
     nall = st%nblocks
     do r = 1, st%nranks - 1
@@ -661,7 +670,10 @@ contains
     nn = st%g%nn
     nd = st%nd
     if (all_fields) then
-       buf = [st%g%mass, reshape(st%g%mom, [nd * nn]), reshape(st%g%force, [nd * nn])]
+       allocate (buf(nn * (1 + 2 * nd)))
+       buf(1:nn) = st%g%mass
+       buf(nn + 1:nn + nd * nn) = reshape(st%g%mom, [nd * nn])
+       buf(nn + nd * nn + 1:) = reshape(st%g%force, [nd * nn])
        call MPI_Allreduce(MPI_IN_PLACE, buf, size(buf), MPI_DOUBLE_PRECISION, MPI_SUM, st%comm)
        st%g%mass = buf(1:nn)
        st%g%mom = reshape(buf(nn + 1:nn + nd * nn), [nd, nn])
