@@ -35,7 +35,7 @@ def run(cmd, env=None):
 
 
 def throughput(out):
-    m = re.search(r"throughput (\d+) particle-steps,\s+([0-9.E+-]+) per second \(time loop\s+([0-9.]+) s\)", out)
+    m = re.search(r"throughput (\d+) particle-steps,\s+([0-9.E+-]+) per second \(time loop\s+([0-9.]+) s", out)
     return (int(m.group(1)), float(m.group(2)), float(m.group(3))) if m else None
 
 
@@ -45,10 +45,14 @@ def main():
     p.add_argument("--increments", type=int, default=3000)
     p.add_argument("--discharge", type=float, default=0.0)
     p.add_argument("--cell", type=float, default=0.025)
+    p.add_argument("--np", type=int, default=1, help="ranks for the --discharge run")
+    p.add_argument("--skip-throughput", action="store_true", help="only the --discharge run")
     a = p.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="bench_mpm_"))
     print(f"bulkflow MPM benchmark ({a.bulkflow}); scratch {tmp}")
-    for shape in ("GIMP", "LINEAR"):
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    for shape in () if a.skip_throughput else ("GIMP", "LINEAR"):
         scene = tmp / f"hopper_{shape.lower()}.inp"
         scene.write_text(hopper_scene(cell=0.05, shape=shape, field_frames=1, history_dt=0.1))
         r, wall = run([a.bulkflow, str(scene), "--output", str(tmp / scene.stem), "--quiet",
@@ -62,28 +66,30 @@ def main():
               f"{t[1]:.3e} particle-steps/s per core (time loop {t[2]:.2f} s, process {wall:.2f} s)")
         timing = r.stdout.split("timing (wall seconds):")[-1]
         print("    " + "\n    ".join(l for l in timing.splitlines() if l.strip()))
-    # 2 ranks
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    r, wall = run(["mpirun", "-np", "2", a.bulkflow, str(tmp / "hopper_gimp.inp"), "--output",
-                   str(tmp / "np2"), "--quiet", "--stop-after", str(a.increments)], env=env)
-    t = throughput(r.stdout)
-    if r.returncode != 0 or t is None:
-        print(r.stdout, r.stderr)
-        sys.exit(1)
-    print(f"  2 ranks, GIMP  : {t[1]:.3e} particle-steps/s in all, {t[1] / 2:.3e} per rank "
-          f"(time loop {t[2]:.2f} s, process {wall:.2f} s)")
-    print(f"    load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    if not a.skip_throughput:
+        # 2 ranks
+        r, wall = run(["mpirun", "-np", "2", a.bulkflow, str(tmp / "hopper_gimp.inp"), "--output",
+                       str(tmp / "np2"), "--quiet", "--stop-after", str(a.increments)], env=env)
+        t = throughput(r.stdout)
+        if r.returncode != 0 or t is None:
+            print(r.stdout, r.stderr)
+            sys.exit(1)
+        print(f"  2 ranks, GIMP  : {t[1]:.3e} particle-steps/s in all, {t[1] / 2:.3e} per rank "
+              f"(time loop {t[2]:.2f} s, process {wall:.2f} s)")
+        print(f"    load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     if a.discharge > 0:
         scene = tmp / "hopper_discharge.inp"
         scene.write_text(hopper_scene(cell=a.cell, discharge_time=a.discharge, field_frames=5, history_dt=0.01))
-        r, wall = run([a.bulkflow, str(scene), "--output", str(tmp / "hopper_discharge"), "--quiet"])
+        cmd = [a.bulkflow, str(scene), "--output", str(tmp / "hopper_discharge"), "--quiet"]
+        if a.np > 1:
+            cmd = ["mpirun", "-np", str(a.np)] + cmd
+        r, wall = run(cmd, env=env)
         t = throughput(r.stdout)
         if r.returncode != 0 or t is None:
             print(r.stdout, r.stderr)
             sys.exit(1)
         npart = re.search(r"(\d+) particles,", r.stdout).group(1)
-        print(f"  ch. 4 hopper, cell {a.cell:g} m ({npart} particles), 1 s fill + {a.discharge:g} s discharge "
+        print(f"  ch. 4 hopper, {a.np} rank(s), cell {a.cell:g} m ({npart} particles), 1 s fill + {a.discharge:g} s discharge "
               f"with inflow: wall time {wall:.1f} s ({wall / (1 + a.discharge):.1f} s per simulated second), "
               f"{t[1]:.3e} particle-steps/s")
         print(f"    history: {tmp / 'hopper_discharge_history.csv'}")
