@@ -14,6 +14,7 @@ program bulkflow
   use model, only: model_t
   use scene_reader, only: read_scene
   use driver_run, only: run_options_t, run_scene
+  use mpm_run, only: mpm_run_scene
   use abaqus_host, only: host_set_exit_handler
   implicit none
   type(model_t) :: m
@@ -36,8 +37,16 @@ program bulkflow
   call read_scene(scene, m, err)
   if (err%raised) call input_error_exit(err)
   if (check_only) then
-     if (rank == 0) write (output_unit, '(a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (', &
-          m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, ' elements, ', m%n_steps, ' steps)'
+     if (rank == 0 .and. m%mpm%active) then
+        write (output_unit, '(a,i0,a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (material points, ', &
+             m%mpm%ndim, 'D, ', size(m%mpm%regions), ' particle regions, ', size(m%mpm%walls), ' walls, ', &
+             m%n_steps, ' steps)'
+     else if (rank == 0) then
+        write (output_unit, '(a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (', &
+             m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, ' elements, ', m%n_steps, ' steps)'
+     end if
+  else if (m%mpm%active) then
+     call run_mpm(m, opts)
   else
      call run_scene(m, MPI_COMM_WORLD, opts)
   end if
@@ -113,6 +122,22 @@ contains
     call MPI_Finalize()
     error stop 2, quiet=.true.
   end subroutine input_error_exit
+
+  !> A material-point scene (particle decomposition over the ranks, src/mpm/mpm_run.f90); no restart.
+  subroutine run_mpm(m, opts)
+    type(model_t), intent(in) :: m
+    type(run_options_t), intent(in) :: opts
+    type(error_t) :: e
+
+    e%raised = .false.
+    if (opts%restart .or. any(m%steps(1:m%n_steps)%restart_write)) then
+       e%message = trim(m%input_file) // ': restart is not available for material-point scenes yet; ' // &
+            'expected no --restart and no *RESTART, WRITE'
+       e%raised = .true.
+    end if
+    if (e%raised) call input_error_exit(e)
+    call mpm_run_scene(m, opts%output_base, opts%progress, opts%stop_after, MPI_COMM_WORLD)
+  end subroutine run_mpm
 
   subroutine abort_all()
     call MPI_Abort(MPI_COMM_WORLD, 2)

@@ -41,11 +41,13 @@ contains
 
     select case (name)
     case ('HEADING', 'NODE', 'ELEMENT', 'NSET', 'ELSET', 'SOLID SECTION', 'MATERIAL', &
-         'SURFACE', 'RIGID BODY', 'SURFACE INTERACTION', 'INITIAL CONDITIONS', 'SECTION CONTROLS')
+         'SURFACE', 'RIGID BODY', 'SURFACE INTERACTION', 'INITIAL CONDITIONS', 'SECTION CONTROLS', &
+         'MPM GRID', 'PARTICLES', 'OUTFLOW')
        keyword_kind = kw_model
-    case ('DYNAMIC', 'DLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'FIXED MASS SCALING', 'STOP CONDITION')
+    case ('DYNAMIC', 'DLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'FIXED MASS SCALING', &
+          'STOP CONDITION', 'INFLOW')
        keyword_kind = kw_step_only
-    case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR')
+    case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR', 'MPM CONTROLS', 'MPM WALL')
        keyword_kind = kw_anywhere
     case ('FRICTION')
        keyword_kind = kw_interaction_option

@@ -19,6 +19,7 @@ module scene_reader
   use scene_surfaces, only: build_surfaces, build_rigid_bodies
   use scene_initial, only: build_initial_conditions
   use scene_steps, only: build_steps
+  use scene_mpm, only: is_mpm_scene, check_mpm_keywords, build_mpm
   implicit none
   private
 
@@ -38,6 +39,7 @@ contains
     type(scene_layout_t) :: layout
     type(mesh_sources_t) :: sources
     logical :: user
+    integer :: grid_block
 
     user = .false.
     if (present(user_subroutine)) user = user_subroutine
@@ -57,6 +59,22 @@ contains
     call read_heading(deck, model, err)
     if (err%raised) return
     allocate (model%nsets(0), model%elsets(0))
+    ! A material-point scene (*MPM GRID) has no mesh: materials, amplitudes, the MPM keywords
+    ! (scene_mpm) and the steps.
+    grid_block = is_mpm_scene(deck)
+    call check_mpm_keywords(deck, grid_block, err)
+    if (err%raised) return
+    if (grid_block /= 0) then
+       allocate (model%element_surfaces(0), model%rigid_surfaces(0))
+       call build_materials(deck, layout, model, user, err)
+       if (err%raised) return
+       call build_amplitudes(deck, model, err)
+       if (err%raised) return
+       call build_mpm(deck, layout, grid_block, model, err)
+       if (err%raised) return
+       call build_steps(deck, layout, model, err)
+       return
+    end if
     call build_mesh(deck, layout, model, sources, err)
     if (err%raised) return
     call build_sets(deck, layout, model, err)

@@ -172,6 +172,8 @@ contains
             call read_output_option(blk, model, c%outputs, err)
          case ('AMPLITUDE')
             ! defined globally by scene_amplitudes
+         case ('MPM CONTROLS', 'MPM WALL', 'INFLOW')
+            ! material-point keywords: read by scene_mpm
          case default
             call blk%fail('*' // blk%name // ' cannot stand inside a step; expected step keywords ' // &
                  '(*DYNAMIC, *BOUNDARY, *DLOAD, *OUTPUT, ...)', err)

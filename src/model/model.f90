@@ -9,6 +9,7 @@ module model
   use model_materials, only: material_t, section_t
   use model_amplitudes, only: amplitude_t
   use model_steps, only: step_t, interaction_t
+  use mpm_scene, only: mpm_scene_t
   implicit none
   private
 
@@ -51,6 +52,7 @@ module model
      type(initial_field_t), allocatable :: initial_fields(:)
      integer :: n_steps = 0
      type(step_t), allocatable :: steps(:)
+     type(mpm_scene_t) :: mpm                 !< material-point part (active with *MPM GRID)
   end type model_t
 
   public :: name_length

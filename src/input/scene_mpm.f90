@@ -1,0 +1,490 @@
+!> The material-point keywords of a scene (bulkflow's own; docs/keywords.md, section "MPM"):
+!>
+!>   *MPM GRID, CELL=h [, SHAPE=GIMP|LINEAR]        data: lo corner; hi corner (2 or 3 values)
+!>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a]   model data or in a step; carries over
+!>   *PARTICLES, MATERIAL=name [, PPC=n] [, TYPE=BOX|POLYGON] [, Z1=, Z2=] [, VX=, VY=, VZ=]
+!>                                                  data: BOX lo; hi  |  POLYGON x, y per line
+!>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, OP=DELETE]
+!>                                                  data 2D: x0, y0, x1, y1 (material on the left)
+!>                                                  data 3D: px, py, pz, nx, ny, nz [; lo; hi]
+!>   *OUTFLOW, BELOW=y                              model data: particles below y leave
+!>   *INFLOW, MATERIAL=name, LEVEL=y [, PPC=n]      in a step: data x1, x2 (3D: x1, z1, x2, z2)
+!>
+!> A scene with *MPM GRID is a material-point scene: it has no *NODE or *ELEMENT mesh; its
+!> materials, amplitudes, steps (*DYNAMIC, EXPLICIT, *DLOAD GRAV, *OUTPUT) are the usual ones.
+!> "Up" is +y (axis 2) in 2D and 3D. The checks end with `file:line: what; expected ...`.
+module scene_mpm
+  use material_kinds, only: dp
+  use error_report, only: error_t, raise_error
+  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t
+  use model, only: model_t
+  use mpm_scene, only: mpm_scene_t, particle_region_t, mpm_wall_t, mpm_step_t, shape_linear, &
+       shape_gimp, region_box, region_polygon, wall_friction, wall_symmetry, wall_name_length
+  use scene_layout, only: scene_layout_t
+  use scene_materials, only: find_material
+  use scene_util, only: itoa, rtoa, get_real, expect_lines, expect_fields, last_field, where_text, &
+       check_name
+  implicit none
+  private
+
+  public :: is_mpm_scene, check_mpm_keywords, build_mpm, mpm_keyword
+
+contains
+
+  !> Is `name` one of the MPM keywords?
+  pure logical function mpm_keyword(name)
+    character(len=*), intent(in) :: name
+    select case (name)
+    case ('MPM GRID', 'MPM CONTROLS', 'PARTICLES', 'MPM WALL', 'OUTFLOW', 'INFLOW')
+       mpm_keyword = .true.
+    case default
+       mpm_keyword = .false.
+    end select
+  end function mpm_keyword
+
+  !> Block index of the *MPM GRID of the deck (0: not an MPM scene).
+  pure integer function is_mpm_scene(deck)
+    type(keyword_deck_t), intent(in) :: deck
+    integer :: i
+    is_mpm_scene = 0
+    do i = 1, deck%n_blocks
+       if (deck%blocks(i)%name == 'MPM GRID') then
+          is_mpm_scene = i
+          return
+       end if
+    end do
+  end function is_mpm_scene
+
+  !> MPM keywords need *MPM GRID; an MPM scene takes no mesh keywords (no FEM-MPM coupling yet).
+  subroutine check_mpm_keywords(deck, grid_block, err)
+    type(keyword_deck_t), intent(in) :: deck
+    integer, intent(in) :: grid_block
+    type(error_t), intent(inout) :: err
+    integer :: i
+
+    do i = 1, deck%n_blocks
+       associate (blk => deck%blocks(i))
+         if (grid_block == 0) then
+            if (mpm_keyword(blk%name)) then
+               call blk%fail('*' // blk%name // ' without *MPM GRID; expected *MPM GRID, CELL=h in a ' // &
+                    'material-point scene', err)
+               return
+            end if
+         else
+            select case (blk%name)
+            case ('NODE', 'ELEMENT', 'NSET', 'ELSET', 'SOLID SECTION', 'SECTION CONTROLS', 'SURFACE', &
+                 'RIGID BODY', 'SURFACE INTERACTION', 'FRICTION', 'CONTACT PAIR', 'BOUNDARY', &
+                 'INITIAL CONDITIONS')
+               call blk%fail('*' // blk%name // ' in a material-point scene (*MPM GRID at ' // &
+                    where_text(deck%blocks(grid_block)%file, deck%blocks(grid_block)%line) // &
+                    '); expected MPM keywords (*PARTICLES, *MPM WALL, ...): meshes and MPM do not mix yet', err)
+               return
+            case ('MPM GRID')
+               if (i /= grid_block) then
+                  call blk%fail('second *MPM GRID (first at ' // where_text(deck%blocks(grid_block)%file, &
+                       deck%blocks(grid_block)%line) // '); expected one grid per scene', err)
+                  return
+               end if
+            end select
+         end if
+       end associate
+    end do
+  end subroutine check_mpm_keywords
+
+  !> Build model%mpm from the deck (after materials, before steps).
+  subroutine build_mpm(deck, layout, grid_block, model, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(scene_layout_t), intent(in) :: layout
+    integer, intent(in) :: grid_block
+    type(model_t), intent(inout) :: model
+    type(error_t), intent(inout) :: err
+    integer :: i, s, nsteps
+    type(mpm_step_t) :: carry
+
+    associate (mpm => model%mpm)
+      mpm%active = .true.
+      call read_grid(deck%blocks(grid_block), mpm, err)
+      if (err%raised) return
+      model%mesh%ndim = mpm%ndim
+      nsteps = layout%n_steps
+      allocate (mpm%regions(0), mpm%walls(0), mpm%steps(max(nsteps, 1)))
+      ! model data
+      do i = 1, deck%n_blocks
+         if (layout%step_of(i) /= 0) cycle
+         associate (blk => deck%blocks(i))
+           select case (blk%name)
+           case ('MPM CONTROLS')
+              call read_controls(blk, carry, err)
+           case ('PARTICLES')
+              call read_particles(blk, model, err)
+           case ('MPM WALL')
+              call read_wall(blk, mpm, 0, max(nsteps, 1), err)
+           case ('OUTFLOW')
+              call read_outflow(blk, mpm, err)
+           case ('INFLOW')
+              call blk%fail('*INFLOW outside a step; expected it inside the step where material flows in', err)
+           end select
+           if (err%raised) return
+         end associate
+      end do
+      if (size(mpm%regions) == 0) then
+         call deck%blocks(grid_block)%fail('material-point scene without *PARTICLES; expected at least ' // &
+              'one *PARTICLES, MATERIAL=...', err)
+         return
+      end if
+      ! steps: controls carry over; inflow belongs to its step; walls from their step on
+      do s = 1, nsteps
+         carry%inflow%on = .false.
+         do i = layout%step_block(s) + 1, layout%end_block(s) - 1
+            associate (blk => deck%blocks(i))
+              select case (blk%name)
+              case ('MPM CONTROLS')
+                 call read_controls(blk, carry, err)
+              case ('MPM WALL')
+                 call read_wall(blk, mpm, s, nsteps, err)
+              case ('INFLOW')
+                 call read_inflow(blk, model, carry, err)
+              case ('PARTICLES', 'OUTFLOW', 'MPM GRID')
+                 call blk%fail('*' // blk%name // ' inside a step; expected it in the model data ' // &
+                      '(before the first *STEP)', err)
+              end select
+              if (err%raised) return
+            end associate
+         end do
+         mpm%steps(s) = carry
+      end do
+    end associate
+  end subroutine build_mpm
+
+  subroutine read_grid(blk, mpm, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(mpm_scene_t), intent(inout) :: mpm
+    type(error_t), intent(inout) :: err
+    character(len=:), allocatable :: shape
+    integer :: n0, n1, k
+
+    call blk%check_params([character(len=8) :: 'CELL', 'SHAPE'], err)
+    if (.not. err%raised) call blk%get_real('CELL', mpm%cell, err, minimum=tiny(1.0_dp))
+    if (.not. err%raised) call blk%get_string('SHAPE', shape, err, default='GIMP', choices=[character(len=6) :: &
+         'GIMP', 'LINEAR'])
+    if (.not. err%raised) call expect_lines(blk, 2, 2, 'two lines: the low corner x, y[, z] and the high ' // &
+         'corner of the grid', err)
+    if (err%raised) return
+    mpm%shape = shape_gimp
+    if (shape == 'LINEAR') mpm%shape = shape_linear
+    n0 = last_field(blk%lines(1))
+    n1 = last_field(blk%lines(2))
+    if (n0 < 2 .or. n0 > 3 .or. n1 /= n0) then
+       call raise_error(blk%lines(2)%file, blk%lines(2)%line, 'grid corners have ' // itoa(n0) // ' and ' // &
+            itoa(n1) // ' values; expected x, y (2D plane strain) or x, y, z (3D) on both lines', err)
+       return
+    end if
+    mpm%ndim = n0
+    do k = 1, n0
+       call get_real(blk%lines(1), k, mpm%lo(k), err)
+       if (.not. err%raised) call get_real(blk%lines(2), k, mpm%hi(k), err)
+       if (err%raised) return
+       if (mpm%hi(k) - mpm%lo(k) < 4 * mpm%cell) then
+          call raise_error(blk%lines(2)%file, blk%lines(2)%line, 'grid extent ' // &
+               rtoa(mpm%hi(k) - mpm%lo(k)) // ' along axis ' // itoa(k) // ' is less than 4 cells of ' // &
+               rtoa(mpm%cell) // '; expected high corner > low corner + 4 CELL', err)
+          return
+       end if
+    end do
+  end subroutine read_grid
+
+  subroutine read_controls(blk, c, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(mpm_step_t), intent(inout) :: c
+    type(error_t), intent(inout) :: err
+    real(dp) :: flip, cfl, damping
+
+    call blk%check_params([character(len=8) :: 'FLIP', 'CFL', 'DAMPING'], err)
+    if (.not. err%raised) call blk%get_real('FLIP', flip, err, default=c%flip, minimum=0.0_dp, maximum=1.0_dp)
+    if (.not. err%raised) call blk%get_real('CFL', cfl, err, default=c%cfl, minimum=1.0e-3_dp, maximum=1.0_dp)
+    if (.not. err%raised) call blk%get_real('DAMPING', damping, err, default=c%damping, minimum=0.0_dp, &
+         maximum=0.99_dp)
+    if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
+    if (err%raised) return
+    c%flip = flip
+    c%cfl = cfl
+    c%damping = damping
+  end subroutine read_controls
+
+  subroutine material_param(blk, model, k, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(model_t), intent(in) :: model
+    integer, intent(out) :: k
+    type(error_t), intent(inout) :: err
+    character(len=:), allocatable :: name
+
+    k = 0
+    call blk%get_string('MATERIAL', name, err)
+    if (err%raised) return
+    k = find_material(model, name)
+    if (k == 0) call blk%fail('material ' // name // ' is not defined; expected the name of a *MATERIAL', err)
+  end subroutine material_param
+
+  subroutine read_particles(blk, model, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(model_t), intent(inout) :: model
+    type(error_t), intent(inout) :: err
+    type(particle_region_t) :: r
+    type(particle_region_t), allocatable :: grown(:)
+    character(len=:), allocatable :: kind
+    integer :: nd, k, il, n
+
+    nd = model%mpm%ndim
+    call blk%check_params([character(len=8) :: 'MATERIAL', 'PPC', 'TYPE', 'Z1', 'Z2', 'VX', 'VY', 'VZ'], err)
+    if (.not. err%raised) call material_param(blk, model, r%material, err)
+    if (.not. err%raised) call blk%get_integer('PPC', r%ppc, err, default=2, minimum=1, maximum=8)
+    if (.not. err%raised) call blk%get_string('TYPE', kind, err, default='BOX', choices=[character(len=7) :: &
+         'BOX', 'POLYGON'])
+    if (.not. err%raised) call blk%get_real('VX', r%velocity(1), err, default=0.0_dp)
+    if (.not. err%raised) call blk%get_real('VY', r%velocity(2), err, default=0.0_dp)
+    if (.not. err%raised) call blk%get_real('VZ', r%velocity(3), err, default=0.0_dp)
+    if (err%raised) return
+    if (nd == 2 .and. (blk%has_param('Z1') .or. blk%has_param('Z2') .or. blk%has_param('VZ'))) then
+       call blk%fail('*PARTICLES: Z1, Z2 and VZ belong to 3D grids; expected them only with a 3D *MPM GRID', err)
+       return
+    end if
+    r%source = where_text(blk%file, blk%line)
+    if (kind == 'BOX') then
+       r%kind = region_box
+       call expect_lines(blk, 2, 2, 'two lines: the low and the high corner of the box', err)
+       if (err%raised) return
+       do il = 1, 2
+          call expect_fields(blk, blk%lines(il), nd, nd, 'x, y' // trim(merge(', z', '   ', nd == 3)), err)
+          if (err%raised) return
+       end do
+       do k = 1, nd
+          call get_real(blk%lines(1), k, r%lo(k), err)
+          if (.not. err%raised) call get_real(blk%lines(2), k, r%hi(k), err)
+          if (err%raised) return
+          if (.not. (r%hi(k) > r%lo(k))) then
+             call raise_error(blk%lines(2)%file, blk%lines(2)%line, 'box high corner is not above the low ' // &
+                  'corner along axis ' // itoa(k) // '; expected hi > lo', err)
+             return
+          end if
+       end do
+    else
+       r%kind = region_polygon
+       call expect_lines(blk, 3, huge(1), 'at least three vertices x, y (one per line)', err)
+       if (err%raised) return
+       n = blk%n_lines
+       allocate (r%polygon(2, n))
+       do il = 1, n
+          call expect_fields(blk, blk%lines(il), 2, 2, 'a vertex x, y', err)
+          if (.not. err%raised) call get_real(blk%lines(il), 1, r%polygon(1, il), err)
+          if (.not. err%raised) call get_real(blk%lines(il), 2, r%polygon(2, il), err)
+          if (err%raised) return
+       end do
+       r%lo(1:2) = minval(r%polygon, dim=2)
+       r%hi(1:2) = maxval(r%polygon, dim=2)
+       if (nd == 3) then
+          call blk%get_real('Z1', r%lo(3), err)
+          if (.not. err%raised) call blk%get_real('Z2', r%hi(3), err)
+          if (err%raised) return
+          if (.not. (r%hi(3) > r%lo(3))) then
+             call blk%fail('*PARTICLES: Z2 must exceed Z1; expected the z range of the extruded polygon', err)
+             return
+          end if
+       end if
+    end if
+    do k = 1, nd
+       if (r%lo(k) < model%mpm%lo(k) + model%mpm%cell .or. r%hi(k) > model%mpm%hi(k) - model%mpm%cell) then
+          call blk%fail('*PARTICLES region reaches beyond the grid less one cell along axis ' // itoa(k) // &
+               '; expected it inside [' // rtoa(model%mpm%lo(k) + model%mpm%cell) // ', ' // &
+               rtoa(model%mpm%hi(k) - model%mpm%cell) // ']', err)
+          return
+       end if
+    end do
+    n = size(model%mpm%regions)
+    allocate (grown(n + 1))
+    grown(1:n) = model%mpm%regions
+    grown(n + 1) = r
+    call move_alloc(grown, model%mpm%regions)
+  end subroutine read_particles
+
+  !> *MPM WALL in model data (step 0: active in all steps) or in step s (active from s on);
+  !> OP=DELETE ends an existing wall at step s.
+  subroutine read_wall(blk, mpm, s, nsteps, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(mpm_scene_t), intent(inout) :: mpm
+    integer, intent(in) :: s, nsteps
+    type(error_t), intent(inout) :: err
+    type(mpm_wall_t) :: w
+    type(mpm_wall_t), allocatable :: grown(:)
+    character(len=:), allocatable :: name, kind, op
+    integer :: nd, k, n, found
+    real(dp) :: t(3), length
+
+    nd = mpm%ndim
+    call blk%check_params([character(len=8) :: 'NAME', 'TYPE', 'FRICTION', 'OP', 'REACH'], err)
+    if (.not. err%raised) call blk%get_string('NAME', name, err)
+    if (.not. err%raised) call check_name(blk, 'wall', name, wall_name_length, err)
+    if (.not. err%raised) call blk%get_string('OP', op, err, default='NEW', choices=[character(len=6) :: &
+         'NEW', 'DELETE'])
+    if (err%raised) return
+    found = 0
+    do k = 1, size(mpm%walls)
+       if (mpm%walls(k)%name == name) found = k
+    end do
+    if (op == 'DELETE') then
+       if (s == 0) then
+          call blk%fail('*MPM WALL, OP=DELETE in model data; expected it inside the step from which the ' // &
+               'wall is gone', err)
+       else if (found == 0) then
+          call blk%fail('*MPM WALL, OP=DELETE: wall ' // name // ' is not defined; expected the NAME of an ' // &
+               'earlier *MPM WALL', err)
+       else if (blk%has_param('TYPE') .or. blk%has_param('FRICTION') .or. blk%has_param('REACH') .or. &
+            blk%n_lines > 0) then
+          call blk%fail('*MPM WALL, OP=DELETE takes only NAME; expected no TYPE, FRICTION, REACH or data lines', err)
+       else
+          mpm%walls(found)%active(s:) = .false.
+       end if
+       return
+    end if
+    if (found /= 0) then
+       call blk%fail('wall ' // name // ' defined twice (first at ' // trim(mpm%walls(found)%source) // &
+            '); expected unique wall names (OP=DELETE ends a wall)', err)
+       return
+    end if
+    w%name = name
+    w%source = where_text(blk%file, blk%line)
+    call blk%get_string('TYPE', kind, err, default='FRICTION', choices=[character(len=8) :: 'FRICTION', 'SYMMETRY'])
+    if (.not. err%raised) call blk%get_real('FRICTION', w%friction, err, default=0.0_dp, minimum=0.0_dp)
+    if (.not. err%raised) call blk%get_real('REACH', w%reach, err, default=0.0_dp, minimum=0.0_dp, maximum=0.99_dp)
+    if (err%raised) return
+    w%kind = wall_friction
+    if (kind == 'SYMMETRY') then
+       w%kind = wall_symmetry
+       if (blk%has_param('FRICTION')) then
+          call blk%fail('*MPM WALL, TYPE=SYMMETRY with FRICTION; expected no friction on a symmetry plane', err)
+          return
+       end if
+    end if
+    if (nd == 2) then
+       call expect_lines(blk, 1, 1, 'one line x0, y0, x1, y1 (the material on the left of p0 -> p1)', err)
+       if (.not. err%raised) call expect_fields(blk, blk%lines(1), 4, 4, 'x0, y0, x1, y1', err)
+       if (err%raised) return
+       do k = 1, 2
+          call get_real(blk%lines(1), k, w%p0(k), err)
+          if (.not. err%raised) call get_real(blk%lines(1), 2 + k, w%p1(k), err)
+          if (err%raised) return
+       end do
+       t = w%p1 - w%p0
+       length = norm2(t)
+       if (.not. (length > 0)) then
+          call raise_error(blk%lines(1)%file, blk%lines(1)%line, 'wall segment has zero length; expected ' // &
+               'two distinct points', err)
+          return
+       end if
+       w%normal = [-t(2), t(1), 0.0_dp] / length
+    else
+       call expect_lines(blk, 1, 3, 'px, py, pz, nx, ny, nz [then the low and high corner of the wall''s box]', err)
+       if (err%raised) return
+       if (blk%n_lines == 2) then
+          call blk%fail('*MPM WALL box needs two lines (low and high corner); expected 1 or 3 data lines', err)
+          return
+       end if
+       call expect_fields(blk, blk%lines(1), 6, 6, 'px, py, pz, nx, ny, nz', err)
+       if (err%raised) return
+       do k = 1, 3
+          call get_real(blk%lines(1), k, w%p0(k), err)
+          if (.not. err%raised) call get_real(blk%lines(1), 3 + k, w%normal(k), err)
+          if (err%raised) return
+       end do
+       length = norm2(w%normal)
+       if (.not. (length > 0)) then
+          call raise_error(blk%lines(1)%file, blk%lines(1)%line, 'wall normal is zero; expected a non-zero ' // &
+               'normal nx, ny, nz pointing into the material', err)
+          return
+       end if
+       w%normal = w%normal / length
+       if (blk%n_lines == 3) then
+          w%bounded = .true.
+          do k = 1, 3
+             call get_real(blk%lines(2), k, w%lo(k), err)
+             if (.not. err%raised) call get_real(blk%lines(3), k, w%hi(k), err)
+             if (err%raised) return
+          end do
+       end if
+    end if
+    allocate (w%active(nsteps))
+    w%active = .false.
+    w%active(max(s, 1):) = .true.
+    n = size(mpm%walls)
+    allocate (grown(n + 1))
+    grown(1:n) = mpm%walls
+    grown(n + 1) = w
+    call move_alloc(grown, mpm%walls)
+  end subroutine read_wall
+
+  subroutine read_outflow(blk, mpm, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(mpm_scene_t), intent(inout) :: mpm
+    type(error_t), intent(inout) :: err
+
+    call blk%check_params([character(len=8) :: 'BELOW'], err)
+    if (.not. err%raised) call blk%get_real('BELOW', mpm%outflow_level, err)
+    if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
+    if (err%raised) return
+    if (mpm%outflow) then
+       call blk%fail('second *OUTFLOW; expected one outflow level per scene', err)
+       return
+    end if
+    ! The removed particles must still have a full stencil inside the grid.
+    if (mpm%outflow_level < mpm%lo(2) + 3 * mpm%cell) then
+       call blk%fail('*OUTFLOW, BELOW=' // rtoa(mpm%outflow_level) // ' is less than 3 cells above the ' // &
+            'bottom of the grid; expected BELOW >= ' // rtoa(mpm%lo(2) + 3 * mpm%cell), err)
+       return
+    end if
+    mpm%outflow = .true.
+  end subroutine read_outflow
+
+  subroutine read_inflow(blk, model, c, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(model_t), intent(in) :: model
+    type(mpm_step_t), intent(inout) :: c
+    type(error_t), intent(inout) :: err
+    integer :: nd, k
+
+    nd = model%mpm%ndim
+    call blk%check_params([character(len=8) :: 'MATERIAL', 'LEVEL', 'PPC'], err)
+    if (.not. err%raised) call material_param(blk, model, c%inflow%material, err)
+    if (.not. err%raised) call blk%get_real('LEVEL', c%inflow%level, err)
+    if (.not. err%raised) call blk%get_integer('PPC', c%inflow%ppc, err, default=2, minimum=1, maximum=8)
+    if (.not. err%raised) call expect_lines(blk, 1, 1, trim(merge('x1, x2        ', 'x1, z1, x2, z2', nd == 2)) // &
+         ' (the band where material flows in)', err)
+    if (err%raised) return
+    c%inflow%lo = 0
+    c%inflow%hi = 0
+    if (nd == 2) then
+       call expect_fields(blk, blk%lines(1), 2, 2, 'x1, x2', err)
+       if (.not. err%raised) call get_real(blk%lines(1), 1, c%inflow%lo(1), err)
+       if (.not. err%raised) call get_real(blk%lines(1), 2, c%inflow%hi(1), err)
+    else
+       call expect_fields(blk, blk%lines(1), 4, 4, 'x1, z1, x2, z2', err)
+       if (.not. err%raised) call get_real(blk%lines(1), 1, c%inflow%lo(1), err)
+       if (.not. err%raised) call get_real(blk%lines(1), 2, c%inflow%lo(3), err)
+       if (.not. err%raised) call get_real(blk%lines(1), 3, c%inflow%hi(1), err)
+       if (.not. err%raised) call get_real(blk%lines(1), 4, c%inflow%hi(3), err)
+    end if
+    if (err%raised) return
+    do k = 1, nd
+       if (k == 2) cycle
+       if (.not. (c%inflow%hi(k) > c%inflow%lo(k))) then
+          call raise_error(blk%lines(1)%file, blk%lines(1)%line, '*INFLOW band is empty along axis ' // &
+               itoa(k) // '; expected the second coordinate above the first', err)
+          return
+       end if
+    end do
+    if (c%inflow%level > model%mpm%hi(2) - 2 * model%mpm%cell) then
+       call blk%fail('*INFLOW, LEVEL=' // rtoa(c%inflow%level) // ' is within 2 cells of the top of the ' // &
+            'grid; expected LEVEL <= ' // rtoa(model%mpm%hi(2) - 2 * model%mpm%cell), err)
+       return
+    end if
+    c%inflow%on = .true.
+  end subroutine read_inflow
+end module scene_mpm

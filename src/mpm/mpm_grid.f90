@@ -1,0 +1,72 @@
+!> The structured background grid: node arrays reset every increment (the grid carries no
+!> history). Node (i, j[, k]) (0-based) has index 1 + i + n1 (j + n2 k) and position lo + (i, j, k) h.
+module mpm_grid
+  use material_kinds, only: dp
+  implicit none
+  private
+
+  type, public :: grid_t
+     integer :: ndim = 0
+     integer :: n(3) = 1                    !< nodes per direction
+     integer :: nn = 0                      !< nodes in all
+     real(dp) :: lo(3) = 0, h = 0
+     real(dp), allocatable :: mass(:)       !< (nn)
+     real(dp), allocatable :: mom(:, :)     !< (ndim, nn) momentum at t_n (P2G)
+     real(dp), allocatable :: force(:, :)   !< (ndim, nn) internal + external force
+     real(dp), allocatable :: v_old(:, :)   !< (ndim, nn) velocity at t_n
+     real(dp), allocatable :: v_new(:, :)   !< (ndim, nn) velocity at t_n+1 (after walls)
+     logical, allocatable :: active(:)      !< mass above the cut-off this increment
+   contains
+     procedure :: position => grid_position
+  end type grid_t
+
+  public :: grid_init, grid_reset
+
+contains
+
+  subroutine grid_init(g, ndim, lo, hi, h)
+    type(grid_t), intent(out) :: g
+    integer, intent(in) :: ndim
+    real(dp), intent(in) :: lo(3), hi(3), h
+    integer :: k
+
+    g%ndim = ndim
+    g%h = h
+    g%lo = lo
+    g%n = 1
+    do k = 1, ndim
+       ! nodes up to the first node line at or beyond hi
+       g%n(k) = ceiling((hi(k) - lo(k)) / h - 1.0e-9_dp) + 1
+    end do
+    g%nn = product(g%n)
+    allocate (g%mass(g%nn), g%mom(ndim, g%nn), g%force(ndim, g%nn), g%v_old(ndim, g%nn), &
+         g%v_new(ndim, g%nn), g%active(g%nn))
+    call grid_reset(g)
+  end subroutine grid_init
+
+  subroutine grid_reset(g)
+    type(grid_t), intent(inout) :: g
+    g%mass = 0
+    g%mom = 0
+    g%force = 0
+    g%v_old = 0
+    g%v_new = 0
+    g%active = .false.
+  end subroutine grid_reset
+
+  !> Position of node `node` (1-based index).
+  pure function grid_position(g, node) result(x)
+    class(grid_t), intent(in) :: g
+    integer, intent(in) :: node
+    real(dp) :: x(3)
+    integer :: r, i, j, k
+
+    r = node - 1
+    i = mod(r, g%n(1))
+    r = r / g%n(1)
+    j = mod(r, g%n(2))
+    k = r / g%n(2)
+    x = g%lo + g%h * [real(dp) :: i, j, k]
+    if (g%ndim == 2) x(3) = 0
+  end function grid_position
+end module mpm_grid

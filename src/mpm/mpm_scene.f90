@@ -1,0 +1,79 @@
+!> The material-point part of a scene (bulkflow's own keywords, docs/keywords.md "MPM"):
+!> background grid, particle regions, rigid walls, outflow and inflow, and the MPM controls of
+!> each step. Filled and checked by src/input/scene_mpm.f90; read by src/mpm/mpm_run.f90.
+!> Only data here: the model keeps one `mpm_scene_t`, inactive unless the scene has *MPM GRID.
+module mpm_scene
+  use material_kinds, only: dp
+  implicit none
+  private
+
+  integer, parameter, public :: shape_linear = 1      !< standard MPM hat functions
+  integer, parameter, public :: shape_gimp = 2        !< uGIMP (particle domain kept, not stretched)
+
+  integer, parameter, public :: region_box = 1
+  integer, parameter, public :: region_polygon = 2    !< 2D polygon; in 3D extruded over z1..z2
+
+  integer, parameter, public :: wall_friction = 1     !< unilateral contact with Coulomb friction
+  integer, parameter, public :: wall_symmetry = 2     !< bilateral, frictionless (v·n = 0)
+
+  integer, parameter, public :: wall_name_length = 80
+
+  !> *PARTICLES: a region filled with a regular lattice of PPC particles per cell direction.
+  type, public :: particle_region_t
+     integer :: material = 0                !< index into model%materials
+     integer :: kind = region_box
+     integer :: ppc = 2                     !< particles per cell and direction
+     real(dp) :: lo(3) = 0, hi(3) = 0       !< box (and the z range of an extruded polygon)
+     real(dp), allocatable :: polygon(:, :) !< (2, n_vertices)
+     real(dp) :: velocity(3) = 0            !< initial velocity
+     character(len=256) :: source = ''
+  end type particle_region_t
+
+  !> *MPM WALL: a rigid, fixed wall. 2D: the segment p0 -> p1, material on its left (as Abaqus
+  !> TYPE=SEGMENTS); 3D: the plane through p0 with unit normal n into the material, limited to
+  !> the box lo..hi when given. Active in the steps flagged in `active(step)`.
+  type, public :: mpm_wall_t
+     character(len=wall_name_length) :: name = ''
+     integer :: kind = wall_friction
+     real(dp) :: friction = 0               !< Coulomb μ = tan δ_w
+     real(dp) :: reach = 0                  !< nodes up to reach·h in front of the wall are constrained too
+     real(dp) :: p0(3) = 0, p1(3) = 0
+     real(dp) :: normal(3) = 0              !< unit, into the material
+     logical :: bounded = .false.           !< 3D: limited to lo..hi
+     real(dp) :: lo(3) = 0, hi(3) = 0
+     logical, allocatable :: active(:)      !< per step
+     character(len=256) :: source = ''
+  end type mpm_wall_t
+
+  !> *INFLOW of a step: keep the free surface at `level` (along the vertical axis) over the
+  !> band lo..hi of the other coordinate(s) by adding layers of particles of `material`.
+  type, public :: mpm_inflow_t
+     logical :: on = .false.
+     integer :: material = 0
+     integer :: ppc = 2
+     real(dp) :: level = 0
+     real(dp) :: lo(3) = 0, hi(3) = 0
+  end type mpm_inflow_t
+
+  !> MPM controls of one step (*MPM CONTROLS carries over to later steps until repeated).
+  type, public :: mpm_step_t
+     real(dp) :: flip = 0.99_dp             !< PIC/FLIP blend α (1: FLIP, 0: PIC)
+     real(dp) :: cfl = 0.3_dp               !< Δt = cfl h / max(c + |v|)
+     real(dp) :: damping = 0                !< local non-viscous damping coefficient on the grid
+     type(mpm_inflow_t) :: inflow
+  end type mpm_step_t
+
+  type, public :: mpm_scene_t
+     logical :: active = .false.
+     integer :: ndim = 0
+     integer :: shape = shape_gimp
+     real(dp) :: cell = 0                   !< grid spacing h (all directions)
+     real(dp) :: lo(3) = 0, hi(3) = 0       !< grid box (node lines at lo + i h)
+     integer :: vertical = 2                !< axis of "up" for outflow/inflow (2 in 2D, AXIS= in 3D)
+     type(particle_region_t), allocatable :: regions(:)
+     type(mpm_wall_t), allocatable :: walls(:)
+     logical :: outflow = .false.
+     real(dp) :: outflow_level = 0          !< particles below this (vertical axis) leave
+     type(mpm_step_t), allocatable :: steps(:)
+  end type mpm_scene_t
+end module mpm_scene

@@ -1,0 +1,135 @@
+!> Shape functions of the background grid for a block of particles: the standard linear hat
+!> functions (2 nodes per direction) and uGIMP (Bardenhagen & Kober 2004; 3 nodes per direction),
+!> as tensor products S_Ip = Π_k N(x_pk − x_Ik) with gradients ∇S_Ip = (N_x' N_y [N_z], ...).
+!>
+!> uGIMP keeps the particle half-length l fixed at its initial value h/(2 ppc) (the "u" of
+!> uGIMP): no domain update with F, so no domain can outgrow the 3-node stencil, and the
+!> kernel is the same for every particle of a block. numerics.md §4.2 has the 1D formulas.
+!>
+!> Layout (block of nb particles, particle index first so the loops over a block vectorize):
+!>   node(nb, ns) global node index (1-based), w(nb, ns) weights, dw(nb, ns, ndim) gradients,
+!>   ns = nsup**ndim stencil nodes, nsup = 2 (linear) or 3 (uGIMP).
+module mpm_shape
+  use material_kinds, only: dp
+  use mpm_scene, only: shape_linear
+  implicit none
+  private
+
+  public :: stencil_nodes_per_direction, block_stencil
+
+contains
+
+  pure integer function stencil_nodes_per_direction(shape)
+    integer, intent(in) :: shape
+    stencil_nodes_per_direction = 3
+    if (shape == shape_linear) stencil_nodes_per_direction = 2
+  end function stencil_nodes_per_direction
+
+  !> Stencil of nb particles at x(nb, ndim) on the grid with origin lo, spacing h and n(3)
+  !> nodes per direction. half = l (uGIMP particle half-length; unused for linear).
+  !> `outside` returns the first particle whose stencil leaves the grid (0: none).
+  pure subroutine block_stencil(nb, ndim, shape, lo, h, n, half, x, node, w, dw, outside)
+    integer, intent(in) :: nb, ndim, shape
+    real(dp), intent(in) :: lo(3), h, half
+    integer, intent(in) :: n(3)
+    real(dp), intent(in) :: x(nb, ndim)
+    integer, intent(out) :: node(nb, *)
+    real(dp), intent(out) :: w(nb, *), dw(nb, *)
+    integer, intent(out) :: outside
+    integer :: base(nb, 3), nsup, ns, p, k, a, b, c, s
+    real(dp) :: n1(nb, 3, 3), d1(nb, 3, 3)
+
+    nsup = stencil_nodes_per_direction(shape)
+    ns = nsup**ndim
+    outside = 0
+    do k = 1, ndim
+       call weights_1d(nb, shape, lo(k), h, half, x(:, k), base(:, k), n1(:, :, k), d1(:, :, k))
+    end do
+    do p = 1, nb
+       do k = 1, ndim
+          if (base(p, k) < 0 .or. base(p, k) + nsup - 1 > n(k) - 1) then
+             if (outside == 0) outside = p
+          end if
+       end do
+    end do
+    if (outside /= 0) return
+    if (ndim == 2) then
+       s = 0
+       do b = 1, nsup
+          do a = 1, nsup
+             s = s + 1
+             do p = 1, nb
+                node(p, s) = 1 + (base(p, 1) + a - 1) + n(1) * (base(p, 2) + b - 1)
+                w(p, s) = n1(p, a, 1) * n1(p, b, 2)
+                dw(p, s) = d1(p, a, 1) * n1(p, b, 2)
+                dw(p, ns + s) = n1(p, a, 1) * d1(p, b, 2)
+             end do
+          end do
+       end do
+    else
+       s = 0
+       do c = 1, nsup
+          do b = 1, nsup
+             do a = 1, nsup
+                s = s + 1
+                do p = 1, nb
+                   node(p, s) = 1 + (base(p, 1) + a - 1) + n(1) * ((base(p, 2) + b - 1) + n(2) * (base(p, 3) + c - 1))
+                   w(p, s) = n1(p, a, 1) * n1(p, b, 2) * n1(p, c, 3)
+                   dw(p, s) = d1(p, a, 1) * n1(p, b, 2) * n1(p, c, 3)
+                   dw(p, ns + s) = n1(p, a, 1) * d1(p, b, 2) * n1(p, c, 3)
+                   dw(p, 2 * ns + s) = n1(p, a, 1) * n1(p, b, 2) * d1(p, c, 3)
+                end do
+             end do
+          end do
+       end do
+    end if
+  end subroutine block_stencil
+
+  !> 1D weights of the nodes base, base+1[, base+2] (0-based node numbers along the axis).
+  pure subroutine weights_1d(nb, shape, lo, h, l, x, base, n1, d1)
+    integer, intent(in) :: nb, shape
+    real(dp), intent(in) :: lo, h, l, x(nb)
+    integer, intent(out) :: base(nb)
+    real(dp), intent(out) :: n1(nb, 3), d1(nb, 3)
+    integer :: p, a
+    real(dp) :: xi, r, ar, sg
+
+    if (shape == shape_linear) then
+       do p = 1, nb
+          xi = (x(p) - lo) / h
+          base(p) = floor(xi)
+          r = xi - base(p)
+          n1(p, 1) = 1 - r
+          n1(p, 2) = r
+          n1(p, 3) = 0
+          d1(p, 1) = -1 / h
+          d1(p, 2) = 1 / h
+          d1(p, 3) = 0
+       end do
+    else
+       do p = 1, nb
+          xi = (x(p) - lo) / h
+          base(p) = nint(xi) - 1
+          do a = 1, 3
+             ! r = x_p − x_I (signed distance to node base + a − 1)
+             r = x(p) - (lo + (base(p) + a - 1) * h)
+             ar = abs(r)
+             sg = sign(1.0_dp, r)
+             if (ar < l) then
+                n1(p, a) = 1 - (r * r + l * l) / (2 * h * l)
+                d1(p, a) = -r / (h * l)
+             else if (ar <= h - l) then
+                n1(p, a) = 1 - ar / h
+                d1(p, a) = -sg / h
+             else if (ar < h + l) then
+                n1(p, a) = (h + l - ar)**2 / (4 * h * l)
+                d1(p, a) = -sg * (h + l - ar) / (2 * h * l)
+             else
+                n1(p, a) = 0
+                d1(p, a) = 0
+             end if
+          end do
+       end do
+    end if
+  end subroutine weights_1d
+end module mpm_shape

@@ -1,0 +1,119 @@
+!> Rigid fixed walls on the background grid (numerics.md §4.4): after the grid momentum update
+!> (and again after the MUSL remap) the velocity of every grid node on or behind an active wall
+!> is projected: a friction wall removes an approaching normal velocity and reduces the
+!> tangential one by μ |Δv_n| (Coulomb; stick when that exceeds it); a symmetry wall removes
+!> the normal velocity both ways.
+!>
+!> Which nodes: those with signed distance d = (x_I − p0)·n <= REACH·h (default 0: on the wall or
+!> behind it) whose projection falls on the wall (2D: the segment p0..p1; 3D: the optional box). A grid-aligned
+!> wall thus acts on its node line exactly as a standard MPM boundary; an inclined wall acts on
+!> the staircase of nodes just behind it, with the exact normal (no staircase friction).
+!> Particles that end an increment behind a wall (the wall's stencil is one cell wide) are put
+!> back onto it: `guard_particles`; the count is reported.
+module mpm_walls
+  use material_kinds, only: dp
+  use mpm_scene, only: mpm_wall_t, wall_symmetry
+  use mpm_grid, only: grid_t
+  implicit none
+  private
+
+  !> A wall with the grid nodes it constrains.
+  type, public :: wall_nodes_t
+     integer, allocatable :: nodes(:)
+  end type wall_nodes_t
+
+  public :: wall_find_nodes, wall_project, wall_contains, wall_distance
+
+contains
+
+  pure real(dp) function wall_distance(w, x)
+    type(mpm_wall_t), intent(in) :: w
+    real(dp), intent(in) :: x(3)
+    wall_distance = dot_product(x - w%p0, w%normal)
+  end function wall_distance
+
+  !> Does the wall extend over the point x (its projection lies on the segment / in the box)?
+  pure logical function wall_contains(w, ndim, x, tol)
+    type(mpm_wall_t), intent(in) :: w
+    integer, intent(in) :: ndim
+    real(dp), intent(in) :: x(3), tol
+    real(dp) :: t(3), length, s
+
+    if (ndim == 2) then
+       t = w%p1 - w%p0
+       length = norm2(t)
+       s = dot_product(x - w%p0, t) / length
+       wall_contains = s >= -tol .and. s <= length + tol
+    else if (w%bounded) then
+       wall_contains = all(x >= w%lo - tol) .and. all(x <= w%hi + tol)
+    else
+       wall_contains = .true.
+    end if
+  end function wall_contains
+
+  subroutine wall_find_nodes(w, g, wn)
+    type(mpm_wall_t), intent(in) :: w
+    type(grid_t), intent(in) :: g
+    type(wall_nodes_t), intent(out) :: wn
+    integer :: i, n
+    integer, allocatable :: list(:)
+    real(dp) :: x(3), tol
+
+    tol = 1.0e-9_dp * g%h
+    allocate (list(g%nn))
+    n = 0
+    do i = 1, g%nn
+       x = g%position(i)
+       if (wall_distance(w, x) > w%reach * g%h + tol) cycle
+       if (.not. wall_contains(w, g%ndim, x, tol)) cycle
+       n = n + 1
+       list(n) = i
+    end do
+    allocate (wn%nodes(n))
+    wn%nodes = list(1:n)
+  end subroutine wall_find_nodes
+
+  !> Project the velocities v(ndim, nn) of the wall's active nodes; with `force`, add the
+  !> force the material exerts on the wall, −Σ m Δv / Δt, and the kinetic energy friction takes
+  !> out of the tangential motion, Σ ½ m (|v_t|² − |v_t,new|²) >= 0, into `dissipated` (the
+  !> normal velocity a wall removes is the reaction to the stress of a resting body, not a loss).
+  subroutine wall_project(w, wn, ndim, mass, active, v, dt, force, dissipated)
+    type(mpm_wall_t), intent(in) :: w
+    type(wall_nodes_t), intent(in) :: wn
+    integer, intent(in) :: ndim
+    real(dp), intent(in) :: mass(:)
+    logical, intent(in) :: active(:)
+    real(dp), intent(inout) :: v(:, :)
+    real(dp), intent(in) :: dt
+    real(dp), intent(inout), optional :: force(3)
+    real(dp), intent(inout), optional :: dissipated
+    integer :: k, i
+    real(dp) :: n(3), vi(3), vn, vt(3), tn, scale, vnew(3)
+
+    tn = 0
+    scale = 1
+
+    n = w%normal
+    do k = 1, size(wn%nodes)
+       i = wn%nodes(k)
+       if (.not. active(i)) cycle
+       vi = 0
+       vi(1:ndim) = v(:, i)
+       vn = dot_product(vi, n)
+       if (w%kind == wall_symmetry) then
+          vnew = vi - vn * n
+       else
+          if (vn >= 0) cycle
+          vt = vi - vn * n
+          tn = norm2(vt)
+          scale = 0
+          if (tn > 0) scale = max(0.0_dp, 1 - w%friction * abs(vn) / tn)
+          vnew = vt * scale
+       end if
+       if (present(force)) force = force - mass(i) * (vnew - vi) / dt
+       if (present(dissipated) .and. w%kind /= wall_symmetry) dissipated = dissipated + 0.5_dp * mass(i) * &
+            tn * tn * (1 - scale * scale)
+       v(:, i) = vnew(1:ndim)
+    end do
+  end subroutine wall_project
+end module mpm_walls
