@@ -105,7 +105,10 @@ class ArchingScene:
     state: str = "passive"           #: "passive" (slide the plate) or "active" (no sliding)
     t_gravity: float = 0.4           #: gravity smooth-step time (s)
     t_slide: float = 0.2             #: sliding step time (s)
-    slide: float = 0.005             #: plate travel toward the apex (m)
+    #: plate travel toward the apex (m). 5 mm left a 3 m fill of Case A short of the passive state
+    #: (its critical width then grew with the height and mass scaling shifted it); from 20 mm on
+    #: the width no longer depends on the travel (20 and 40 mm within 1 cm), as thesis §6.2 says.
+    slide: float = 0.02
     t_open: float = 1.0              #: longest opening step (s); the stop condition ends it earlier
     mass_scaling_dt_factor: float = 4.0   #: steps 1-2: BELOW MIN to this × the smallest increment; ≤ 1: none
     stop: bool = True                #: *STOP CONDITION in the opening step
