@@ -268,7 +268,7 @@ contains
     call h5screate_simple_f(size(dims), dims, space, hdferr)
     call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, hdferr)
     call check(hdferr, 'creating dataset ' // name)
-    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, a, dims, hdferr)
+    if (size(a) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, a, dims, hdferr)
     call check(hdferr, 'writing dataset ' // name)
     call h5dclose_f(dset, hdferr)
     call h5sclose_f(space, hdferr)
@@ -278,17 +278,7 @@ contains
     integer(hid_t), intent(in) :: loc
     character(len=*), intent(in) :: name
     real(dp), intent(in) :: a(:)
-    integer(hsize_t) :: dims(1)
-    integer(hid_t) :: space, dset
-    integer :: hdferr
-    dims = shape(a, kind=hsize_t)
-    call h5screate_simple_f(1, dims, space, hdferr)
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, hdferr)
-    call check(hdferr, 'creating dataset ' // name)
-    if (size(a) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, a, dims, hdferr)
-    call check(hdferr, 'writing dataset ' // name)
-    call h5dclose_f(dset, hdferr)
-    call h5sclose_f(space, hdferr)
+    call write_shaped(loc, name, a, shape(a, kind=hsize_t))
   end subroutine write_r1
 
   subroutine write_i1(loc, name, a)
