@@ -10,16 +10,36 @@ falling 2 cells below the outlet leave (*OUTFLOW), optional *INFLOW keeps the to
 
 Material (Table 4.2/4.3): rho 1600, E 10 MPa, nu 0.2, phi 20 deg, psi 15 -> 0 deg over
 volumetric strain 0 -> 0.2 (VUSDFLD field 1 = tr LE), c = 0, wall friction tan 5 deg.
+Every one of these is a parameter (the parametric studies of thesis §4.5.8 vary them):
+`phi`, `psi_initial`, `eps_cv` (volumetric strain at which psi reaches 0; thesis eq. 4.1
+eps_cv = ln(eta_i/eta_cv), see `eps_cv_from_eta`), `young`, `poisson`, `density`;
+`psi_constant` replaces the table by a constant dilation angle (thesis Fig. 4.14's psi = 10 deg);
+`model="DP"` gives the linear Drucker-Prager material matched to Mohr-Coulomb in plane strain
+(thesis eq. 3.2, umat/README.md DP mode 1) with the constant dilation `psi_constant` (default 0).
 """
 import argparse
 import math
 import sys
 
+ETA_INITIAL = 0.64          # random close packing (thesis §4.3)
+
+
+def _num(x):
+    """A real as Abaqus input writes it: 9 significant digits, always with a decimal point."""
+    t = f"{x:.9g}"
+    return t if ("." in t or "e" in t) else t + "."
+
+
+def eps_cv_from_eta(eta_cv, eta_i=ETA_INITIAL):
+    """Volumetric strain at which dilation stops: thesis eq. 4.1, eps_v = ln(eta_i / eta_cv)."""
+    return math.log(eta_i / eta_cv)
+
 
 def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_friction=5.0,
                  fill_time=1.0, ramp=0.6, discharge_time=3.0, inflow=True, fill_damping=0.1,
                  flip=0.99, cfl=0.3, shape="GIMP", field_frames=10, history_dt=0.01,
-                 dilation=True, title=""):
+                 dilation=True, title="", phi=20.0, psi_initial=15.0, eps_cv=0.2,
+                 psi_constant=None, young=1.0e7, poisson=0.2, density=1600.0, model="MC"):
     t = math.radians(theta)
     y0 = 0.5 * outlet / math.tan(t)          # outlet level
     ytop = y0 + height
@@ -45,26 +65,39 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w(f"{lo[0]:.9f}, {lo[1]:.9f}")
     w(f"{hi[0]:.9f}, {hi[1]:.9f}")
     w(f"*MPM CONTROLS, FLIP={flip:g}, CFL={cfl:g}, DAMPING={fill_damping:g}")
-    w("*MATERIAL, NAME=MC-FILL")
+    name = "DP-FILL" if model == "DP" else "MC-FILL"
+    w(f"*MATERIAL, NAME={name}")
     w("*DENSITY")
-    w("1600.")
-    if dilation:
+    w(f"{_num(density)}")
+    if model == "DP":
+        # linear Drucker-Prager from the Mohr-Coulomb parameters by the plane-strain match
+        w("*USER MATERIAL, CONSTANTS=6")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant or 0.0)}, 0., 1.")
+        w("*DEPVAR")
+        w("8")
+    elif psi_constant is not None:
+        w("*USER MATERIAL, CONSTANTS=16")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant)}, 0., 0., 0., 0.")
+        w("0., 0., 0., 0., 0., 1., 0., 0.")
+        w("*DEPVAR")
+        w("8")
+    elif dilation:
         # props layout: umat/README.md (as inputs/demo/wedge_hopper_dilation.inp)
         w("*USER MATERIAL, CONSTANTS=22")
-        w("10000000., 0.2, 20., 0., 0., 0., 0., 0.")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, 0., 0., 0., 0., 0.")
         w("0., 0., 0., 0., 2., 1., 0., 0.")
-        w("20., 15., 0., 20., 0., 0.2")
+        w(f"{_num(phi)}, {_num(psi_initial)}, 0., {_num(phi)}, 0., {_num(eps_cv)}")
         w("*DEPVAR")
         w("8")
         w("*USER DEFINED FIELD")
     else:
         w("*ELASTIC")
-        w("1.0e7, 0.2")
+        w(f"{_num(young)}, {_num(poisson)}")
         w("*MOHR COULOMB")
-        w("20., 0.")
+        w(f"{_num(phi)}, 0.")
         w("*MOHR COULOMB HARDENING")
         w("0., 0.")
-    w(f"*PARTICLES, MATERIAL=MC-FILL, PPC={ppc}, TYPE=POLYGON")
+    w(f"*PARTICLES, MATERIAL={name}, PPC={ppc}, TYPE=POLYGON")
     for x, y in [(0.0, y0), (0.5 * outlet, y0), (xtop, ytop), (0.0, ytop)]:
         w(f"{x:.9f}, {y:.9f}")
     w("*MPM WALL, NAME=AXIS, TYPE=SYMMETRY")
@@ -95,7 +128,7 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w(f"*MPM CONTROLS, DAMPING=0.")
     w("*MPM WALL, NAME=OUTLET, OP=DELETE")
     if inflow:
-        w(f"*INFLOW, MATERIAL=MC-FILL, LEVEL={ytop:.9f}, PPC={ppc}")
+        w(f"*INFLOW, MATERIAL={name}, LEVEL={ytop:.9f}, PPC={ppc}")
         w(f"0., {xtop:.9f}")
     w(f"*OUTPUT, FIELD, NUMBER INTERVAL={field_frames}")
     w("*ELEMENT OUTPUT")
@@ -124,12 +157,25 @@ def main(argv=None):
     p.add_argument("--cfl", type=float, default=0.3)
     p.add_argument("--field-frames", type=int, default=10)
     p.add_argument("--history-dt", type=float, default=0.01)
+    p.add_argument("--phi", type=float, default=20.0, help="internal friction angle [deg]")
+    p.add_argument("--psi-initial", type=float, default=15.0, help="dilation angle at eps_v = 0 [deg]")
+    p.add_argument("--eta-cv", type=float, help="constant-volume solid fraction (eps_cv = ln(0.64/eta_cv))")
+    p.add_argument("--eps-cv", type=float, default=0.2, help="volumetric strain where psi reaches 0")
+    p.add_argument("--psi-constant", type=float, help="constant dilation angle instead of the table [deg]")
+    p.add_argument("--young", type=float, default=1.0e7)
+    p.add_argument("--poisson", type=float, default=0.2)
+    p.add_argument("--density", type=float, default=1600.0)
+    p.add_argument("--model", choices=["MC", "DP"], default="MC")
     a = p.parse_args(argv)
     text = hopper_scene(cell=a.cell, ppc=a.ppc, theta=a.theta, outlet=a.outlet, height=a.height,
                         wall_friction=a.wall_friction, fill_time=a.fill_time,
                         discharge_time=a.discharge_time, inflow=not a.no_inflow,
                         dilation=not a.no_dilation, shape=a.shape, flip=a.flip, cfl=a.cfl,
-                        field_frames=a.field_frames, history_dt=a.history_dt)
+                        field_frames=a.field_frames, history_dt=a.history_dt, phi=a.phi,
+                        psi_initial=a.psi_initial,
+                        eps_cv=eps_cv_from_eta(a.eta_cv) if a.eta_cv else a.eps_cv,
+                        psi_constant=a.psi_constant, young=a.young, poisson=a.poisson,
+                        density=a.density, model=a.model)
     with open(a.output, "w") as f:
         f.write(text)
     return 0
