@@ -9,6 +9,7 @@ scene hash is read back instead of run again (`reuse=False` forces a new run).
     r = run_hopper(exe, "out/mpm_study/runs", cell=0.05, discharge_time=1.5, phi=25.0)
     r["mdr_full"], r["mfi"], r["base"]     # base: output base for paths.py / discharge.py
 """
+import fcntl
 import hashlib
 import json
 import re
@@ -43,10 +44,17 @@ def run_hopper(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, ranks=
     out.mkdir(parents=True, exist_ok=True)
     base = out / f"hopper_{label + '_' if label else ''}{digest}"
     meta = base.with_suffix(".json")
-    if reuse and meta.exists():
-        r = json.loads(meta.read_text())
-        if r.get("digest") == digest:
-            return r
+    # two studies asking for the same case at once: the second waits and reads the first's result
+    with open(base.with_suffix(".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if reuse and meta.exists():
+            r = json.loads(meta.read_text())
+            if r.get("digest") == digest:
+                return r
+        return _run_and_reduce(exe, base, meta, text, digest, ranks, scene)
+
+
+def _run_and_reduce(exe, base, meta, text, digest, ranks, scene):
     scene_path = base.with_suffix(".inp")
     scene_path.write_text(text)
     cmd = [exe, str(scene_path), "--output", str(base), "--quiet"]
