@@ -5,7 +5,7 @@ and the effects check. A benchmark script that prints figures, not a test.
   .venv/bin/python scripts/bench_solver.py [--repeats 3] [--increments 600] [--only throughput,ccx,effects]
                                            [--build build] [--ccx-increments 40]
 
-Takes about 12 minutes on 2 cores (most of it CalculiX).
+Takes about 15 minutes on 2 cores (most of it CalculiX; the baseline build of part 4 adds ~2 min once).
 
 0. Machine capacity: two independent 1-rank runs at once against one alone. On a shared machine
    (other developers' jobs) the second core may not be free; then no 2-rank speed-up is possible
@@ -31,6 +31,10 @@ Takes about 12 minutes on 2 cores (most of it CalculiX).
    is flat, ψ = 0 at both ends, so the mechanics are identical) and without: both timing tables,
    that 'user field' has no line when absent, peak memory (max RSS of a 1-rank run, /usr/bin/time -v)
    and that both give the same energies.
+
+4. Instruction set: the build against a baseline-x86-64 build of the same source (made in
+   build-baseline/, the bulkflow target only), runs interleaved: the gain of the AVX2 default
+   (cmake/BulkflowFlags.cmake) and that both give byte-identical histories.
 
 Targets: ≥ 5 M CPE4R Mohr-Coulomb element-steps/s per core; ≥ 1.8× speed-up on 2 ranks for
 ≥ 20 000 elements; faster than ccx. The machine may be shared: every figure is the median of
@@ -346,6 +350,49 @@ def effects_check(exe, scene_dir, work, repeats):
           + ("" if same else f"  {a[0]['energies']} vs {b[0]['energies']}"))
 
 
+def build_march(build: Path) -> str:
+    """The -march of a build's optimised flags, from its CMake cache (BulkflowFlags.cmake)."""
+    cache = (build / "CMakeCache.txt").read_text() if (build / "CMakeCache.txt").exists() else ""
+    def value(key):
+        m = re.search(rf"^{key}:\w+=(.*)$", cache, re.M)
+        return m.group(1).strip() if m else ""
+    if value("BULKFLOW_NATIVE") in ("ON", "TRUE", "1"):
+        return "native"
+    arch = value("BULKFLOW_ARCH") or "auto"
+    if arch == "auto":
+        return "x86-64-v3" if value("BULKFLOW_HOST_RUNS_X86_64_V3") in ("1", "TRUE", "ON") else "compiler default"
+    return arch
+
+
+def instruction_set(exe, build: Path, scene_dir, work, repeats, baseline_dir: Path):
+    """The benchmark's build against a baseline-x86-64 build of the same source: throughput of
+    each and whether their histories agree byte for byte (they must: FMA is off)."""
+    print(f"\n== 4. instruction set: {build.name} (-march={build_march(build)}) against a baseline build "
+          f"({baseline_dir.name}, the compiler's default -march), 1 rank, runs interleaved")
+    base_exe = baseline_dir / "bin" / "bulkflow"
+    cfg = ["cmake", "-S", str(REPO), "-B", str(baseline_dir), "-DCMAKE_BUILD_TYPE=Release", "-DBULKFLOW_ARCH=default",
+           f"-DPython3_EXECUTABLE={sys.executable}"]
+    if not (baseline_dir / "CMakeCache.txt").exists() and shutil.which("ninja"):
+        cfg += ["-G", "Ninja"]
+    for cmd in (cfg, ["cmake", "--build", str(baseline_dir), "--target", "bulkflow", "--parallel", str(os.cpu_count())]):
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        if p.returncode != 0:
+            print(f"  building the baseline failed; skipped\n{p.stdout[-1500:]}{p.stderr[-1500:]}")
+            return
+    for case in ("cpe4r_mc", "c3d8r_mc"):
+        scene = scene_dir / f"{case}.inp"
+        runs = {"this": [], "baseline": []}
+        for _ in range(repeats):
+            for key, e in (("this", exe), ("baseline", base_exe)):
+                runs[key].append(run_bulkflow(e, scene, 1, work / "arch" / key))
+        hist = [(work / "arch" / key / f"{case}_history.csv").read_bytes() for key in ("this", "baseline")]
+        n_el, n_inc = runs["this"][0]["elements"], runs["this"][0]["increments"]
+        rate = {k: [n_el * r["increments"] / r["total"] for r in v] for k, v in runs.items()}
+        ratio = statistics.median(rate["this"]) / statistics.median(rate["baseline"])
+        print(f"  {case:10s} {build_march(build):>16s}: {med_range(rate['this'], 1e6)} M el-steps/s; baseline: "
+              f"{med_range(rate['baseline'], 1e6)}; ratio {ratio:.2f}×; histories byte-identical: {hist[0] == hist[1]}")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--build", default=str(REPO / "build"))
@@ -353,8 +400,10 @@ def main() -> int:
     ap.add_argument("--increments", type=int, default=600, help="increments per throughput run (about)")
     ap.add_argument("--ccx-increments", type=int, default=40,
                     help="short CalculiX run: this many bulkflow-sized increments of time (the long one: twice)")
-    ap.add_argument("--only", default="throughput,ccx,effects",
-                    help="any of capacity, throughput (includes capacity), ccx, effects")
+    ap.add_argument("--only", default="throughput,ccx,effects,arch",
+                    help="any of capacity, throughput (includes capacity), ccx, effects, arch")
+    ap.add_argument("--baseline-build", default=str(REPO / "build-baseline"),
+                    help="arch: where the baseline-instruction-set build is made (bulkflow target only)")
     ap.add_argument("--cases", default="cpe4r_elastic,cpe4r_mc,c3d8r_elastic,c3d8r_mc")
     ap.add_argument("--scenes", default=str(REPO / "inputs" / "bench"), help="where the scenes are written")
     ap.add_argument("--work", default=str(REPO / "out" / "bench"), help="outputs of the runs")
@@ -371,7 +420,8 @@ def main() -> int:
     scene_dir, work = Path(a.scenes), Path(a.work)
     write_scenes(scene_dir, scenes, force=False)
     only = set(a.only.split(","))
-    print(f"bulkflow solver benchmark: {exe}, {os.cpu_count()} cores, load average {load_average():.2f}; "
+    print(f"bulkflow solver benchmark: {exe} (-march={build_march(Path(a.build))}), {os.cpu_count()} cores, "
+          f"load average {load_average():.2f}; "
           f"scenes in {scene_dir}")
     for name, s in scenes.items():
         print(f"  {name:22s} {s.n_elements():6d} {'CPE4R' if s.dim == 2 else 'C3D8R'}, "
@@ -389,6 +439,8 @@ def main() -> int:
             print("\n== 2. CalculiX: ccx not found (apt-get install -y calculix-ccx); skipped")
     if "effects" in only:
         effects_check(exe, scene_dir, work, a.repeats)
+    if "arch" in only:
+        instruction_set(exe, Path(a.build), scene_dir, work, a.repeats, Path(a.baseline_build))
     return 0
 
 

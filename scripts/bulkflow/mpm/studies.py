@@ -27,7 +27,10 @@ import importlib.util
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from .hopper_run import DEFAULT_EXE, run_hopper
+from .paths import frames, outlet_path, wall_path
 
 # study name -> module of this package with add_arguments(parser) and run(args)
 MODULE_STUDIES = {
@@ -53,25 +56,108 @@ def case(a, **scene):
     return run_hopper(a.bulkflow, a.runs, reuse=not a.no_reuse, **scene)
 
 
+def _profiles(r, frames_used=3):
+    """Outlet v_y profile and discharging wall normal stress of a run (last frames averaged)."""
+    import h5py
+    sc = r["scene"]
+    with h5py.File(r["base"] + ".h5", "r") as f:
+        groups = frames(f, frames_used)
+        op = outlet_path(groups, sc["cell"], sc.get("theta", 30.0), sc.get("outlet", 0.25))
+        wp = wall_path(groups, sc["cell"], sc.get("theta", 30.0), sc.get("outlet", 0.25))
+    return op, wp
+
+
+def profile_difference(s_ref, v_ref, s, v):
+    """RMS of (v - v_ref) over the reference points inside the other profile's range, relative to
+    the RMS of v_ref there: how far a coarse profile lies from the reference, as one number."""
+    s_ref, v_ref, s, v = (np.asarray(q, dtype=float) for q in (s_ref, v_ref, s, v))
+    ok = np.isfinite(v)
+    s, v = s[ok], v[ok]
+    inside = (s_ref >= s.min()) & (s_ref <= s.max()) & np.isfinite(v_ref)
+    if inside.sum() < 2:
+        return float("nan")
+    d = np.interp(s_ref[inside], s, v) - v_ref[inside]
+    return float(np.sqrt(np.mean(d * d)) / np.sqrt(np.mean(v_ref[inside] ** 2)))
+
+
 def convergence(a):
+    """Study a and item 6: grid size, particles per cell and shape functions against the steady
+    MDR, the outlet centre velocity, the outlet v_y profile and the discharging wall normal stress
+    (thesis Fig. 4.7), with the wall time of each run."""
+    cases = [(c, a.ppc, a.shape) for c in a.cells]
+    cases += [(a.variant_cell, p, a.shape) for p in a.ppcs if (a.variant_cell, p, a.shape) not in cases]
+    cases += [(a.variant_cell, a.ppc, sh) for sh in a.shapes if (a.variant_cell, a.ppc, sh) not in cases]
     rows = []
-    for c in a.cells:
-        r = case(a, cell=c, discharge_time=a.discharge, shape=a.shape)
-        r["cell"] = c
+    for cell, ppc, shape in cases:
+        r = case(a, cell=cell, ppc=ppc, discharge_time=a.discharge, shape=shape)
+        r.update(cell=cell, ppc=ppc, shape=shape)
+        r["outlet_profile"], r["wall_profile"] = _profiles(r)
+        r["v_centre"] = float(r["outlet_profile"][0, 1])
         rows.append(r)
-    ref = min(rows, key=lambda r: r["cell"])
-    print(f"wedge hopper (thesis ch. 4), {a.shape}, 1 s fill + {a.discharge:g} s discharge with inflow; "
-          f"reference: cell {ref['cell']:g} m")
-    print(f"{'cell':>6} {'particles':>9} {'wall s':>8} {'Mpst/s':>7} {'MDR kg/s/m':>11} {'dMDR':>7} "
-          f"{'v_out':>7} {'dv':>7} {'rho_out':>8} {'drho':>7} {'MFI':>6}")
+    ref = min((r for r in rows if r["ppc"] == a.ppc and r["shape"] == a.shape), key=lambda r: r["cell"])
+    print(f"wedge hopper (thesis ch. 4), 1 s fill + {a.discharge:g} s discharge with inflow; reference: "
+          f"cell {ref['cell']:g} m, {ref['ppc']} PPC, {ref['shape']}")
+    head = (f"{'cell':>6} {'PPC':>3} {'shape':>6} {'particles':>9} {'wall s':>7} {'MDR kg/s/m':>10} {'dMDR':>7} "
+            f"{'v_c m/s':>8} {'dv_c':>7} {'rho_out':>7} {'MFI':>5} {'d v(x)':>7} {'d sig_n':>7}")
+    print(head)
+    table = []
     for r in rows:
-        def rel(k):
-            return r[k] / ref[k] - 1
-        print(f"{r['cell']:6.3f} {r['particles']:9d} {r['wall']:8.1f} {r['psteps'] / r['wall'] / 1e6:7.3f} "
-              f"{r['mdr_full']:11.2f} {rel('mdr'):+7.3f} {r['v_out']:7.3f} {rel('v_out'):+7.3f} "
-              f"{r['rho_out']:8.1f} {rel('rho_out'):+7.3f} {r['mfi']:6.3f}")
-    print("MDR: full hopper (twice the half model), per metre of depth; v_out, rho_out: outlet path means "
-          "(last 3 frames); d*: relative to the reference; wall s: of the run that made the figures")
+        dv_prof = profile_difference(ref["outlet_profile"][:, 0], ref["outlet_profile"][:, 1],
+                                     r["outlet_profile"][:, 0], r["outlet_profile"][:, 1])
+        dsig = profile_difference(ref["wall_profile"][:, 0], ref["wall_profile"][:, 2],
+                                  r["wall_profile"][:, 0], r["wall_profile"][:, 2])
+        row = dict(cell=r["cell"], ppc=r["ppc"], shape=r["shape"], particles=r["particles"], wall_s=r["wall"],
+                   mdr_full=r["mdr_full"], d_mdr=r["mdr"] / ref["mdr"] - 1, v_centre=r["v_centre"],
+                   d_v_centre=r["v_centre"] / ref["v_centre"] - 1, rho_out=r["rho_out"], mfi=r["mfi"],
+                   d_outlet_profile=dv_prof, d_wall_stress=dsig)
+        table.append(row)
+        print(f"{row['cell']:6.3f} {row['ppc']:3d} {row['shape']:>6} {row['particles']:9d} {row['wall_s']:7.1f} "
+              f"{row['mdr_full']:10.1f} {row['d_mdr']:+7.3f} {row['v_centre']:8.3f} {row['d_v_centre']:+7.3f} "
+              f"{row['rho_out']:7.1f} {row['mfi']:5.2f} {dv_prof:7.3f} {dsig:7.3f}")
+    print("MDR: full hopper (twice the half model) per metre of depth; v_c: outlet centre velocity; d*: relative to "
+          "the reference; d v(x), d sig_n: RMS difference of the outlet v_y profile and of the discharging wall "
+          "normal stress from the reference's, relative to the reference's RMS (last 3 frames); wall s: of the run")
+    out = Path(a.out)
+    import csv
+    import json
+    with open(out / "convergence.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(table[0]))
+        w.writeheader()
+        w.writerows(table)
+    (out / "convergence.json").write_text(json.dumps(dict(reference=dict(cell=ref["cell"], ppc=ref["ppc"],
+                                                                        shape=ref["shape"]), rows=table), indent=1))
+    with open(out / "convergence_profiles.csv", "w") as f:
+        f.write("cell,ppc,shape,path,s_or_x,value\n")
+        for r in rows:
+            for x, v in r["outlet_profile"][:, :2]:
+                f.write(f"{r['cell']},{r['ppc']},{r['shape']},outlet_v_y,{x:.6g},{v:.6g}\n")
+            for sw, sig in r["wall_profile"][:, [0, 2]]:
+                f.write(f"{r['cell']},{r['ppc']},{r['shape']},wall_sigma_n,{sw:.6g},{sig:.6g}\n")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.5))
+    for r in rows:
+        lab = f"h={r['cell']:g} m, {r['ppc']} PPC, {r['shape']}"
+        ax[0].plot(r["outlet_profile"][:, 0] / (0.5 * r["scene"]["outlet"]), -r["outlet_profile"][:, 1], "o-",
+                   ms=3, label=lab)
+        ax[1].plot(r["wall_profile"][:, 2] / 1e3, r["wall_profile"][:, 1], "-", label=lab)
+        ax[2].loglog([r["wall"]], [abs(r["mdr"] / ref["mdr"] - 1) + 1e-4], "o")
+        ax[2].annotate(f"{r['cell']:g}/{r['ppc']}/{r['shape'][0]}", (r["wall"], abs(r["mdr"] / ref["mdr"] - 1) + 1e-4),
+                       fontsize=7)
+    ax[0].set_xlabel("x / (b/2) (axis → wall)")
+    ax[0].set_ylabel("downward velocity at the outlet [m/s]")
+    ax[0].legend(fontsize=7)
+    ax[0].set_title("(a) outlet velocity (Fig. 4.7a)")
+    ax[1].set_xlabel("discharging wall normal stress [kPa]")
+    ax[1].set_ylabel("height above the apex [m]")
+    ax[1].set_title("(b) wall normal stress (Fig. 4.7b)")
+    ax[2].set_xlabel("wall time of the run [s]")
+    ax[2].set_ylabel("|MDR / MDR_ref − 1| (+1e-4)")
+    ax[2].set_title("accuracy vs cost (cell/PPC/shape)")
+    fig.tight_layout()
+    fig.savefig(out / "convergence.png", dpi=120)
+    print(f"wrote {out}/convergence.csv, convergence_profiles.csv, convergence.json, convergence.png")
 
 
 def sweep(a):
@@ -92,7 +178,12 @@ def main(argv=None):
                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
     sub = p.add_subparsers(dest="study", required=True)
     c = sub.add_parser("convergence", help="grid convergence and accuracy vs cost (a, item 6)")
-    c.add_argument("--cells", type=float, nargs="+", default=[0.1, 0.07, 0.05])
+    c.add_argument("--cells", type=float, nargs="+", default=[0.1, 0.07, 0.05, 0.035])
+    c.add_argument("--ppc", type=int, default=2, help="particles per cell direction of the cell series")
+    c.add_argument("--variant-cell", type=float, default=0.05, help="cell of the PPC and shape variants")
+    c.add_argument("--ppcs", type=int, nargs="+", default=[3], help="other PPCs at --variant-cell")
+    c.add_argument("--shapes", nargs="+", default=["LINEAR"], choices=["GIMP", "LINEAR"],
+                   help="other shape functions at --variant-cell")
     s = sub.add_parser("sweep", help="MDR and flow mode vs b and theta (first look)")
     s.add_argument("--outlets", type=float, nargs="+", default=[0.15, 0.25, 0.35])
     s.add_argument("--thetas", type=float, nargs="+", default=[15.0, 30.0, 45.0])
