@@ -16,6 +16,7 @@ module driver_elements
   use fem_corotation, only: corotational_increment, deformation_gradient, to_global, vumat_defgrad, &
        vumat_stretch
   use fem_bulk_viscosity, only: bulk_viscosity
+  use driver_plastic_strain, only: add_elastic_compliance
   use fem_stable_dt, only: element_stable_dt
   use fem_inversion, only: check_inversion, inversion_reason_text, default_min_volume_ratio
   use fem_hourglass, only: hourglass_viscous, default_hourglass_viscous_coefficient, &
@@ -264,6 +265,13 @@ contains
     w%volume_abs(1:nb) = abs(w%volume_mid(1:nb))
     w%density(1:nb) = blk%mass / w%volume_abs(1:nb)
 
+    ! PE (only when written): Δε^p = Δε − C⁻¹(σ_new − σ_old); the σ_old part before the call.
+    if (size(blk%plastic_strain, 1) == nb) then
+       associate (props => m%materials(blk%material)%props)
+         call add_elastic_compliance(nb, nc, props(1), props(2), 1.0_dp, blk%stress, blk%plastic_strain)
+       end associate
+       blk%plastic_strain = blk%plastic_strain + w%strain_corot(1:nb, :)
+    end if
     call effects%stop(effect_elements)
     call effects%start(effect_material)
     call call_material(m%materials(blk%material), nb, nc, ns, blk%elem_number, solver%step_time + dt, &
@@ -282,6 +290,11 @@ contains
        blk%log_strain = blk%log_strain + w%strain_corot(1:nb, :)
     end if
     call effects%start(effect_elements)
+    if (size(blk%plastic_strain, 1) == nb) then
+       associate (props => m%materials(blk%material)%props)
+         call add_elastic_compliance(nb, nc, props(1), props(2), -1.0_dp, blk%stress, blk%plastic_strain)
+       end associate
+    end if
     blk%rotation = w%r_new(1:nb, :, :)
     call to_global(nb, nd, nc, blk%rotation, blk%stress, blk%stress_global)
 

@@ -9,7 +9,7 @@ module driver_output
   use model_steps, only: field_output_t, history_output_t
   use parallel_partition, only: partition_t, local_node_index
   use parallel_assembly, only: global_sum
-  use driver_solver, only: solver_t
+  use driver_solver, only: solver_t, element_block_t
   use output_hdf5, only: field_writer_t, field_writer_open, field_writer_frame, field_writer_end_frame, &
        field_writer_coordinates, field_writer_node_field, field_writer_element_field, field_writer_close, &
        field_writer_frame_count
@@ -259,23 +259,22 @@ contains
           end associate
        end do
        call field_writer_element_field(out%fields, 'S', solver%part%elem_global, values)
-    case ('LE')
-       ! LE is accumulated in the corotational frame; written, like S, in global components
-       ! (before: corotational ones, which differ as soon as an element rotates). Shear
-       ! components are tensor components, as the VUMAT's strains.
+    case ('LE', 'PE')
+       ! LE and PE (driver_plastic_strain) are accumulated in the corotational frame; written,
+       ! like S, in global components. Shear components are tensor components, as the VUMAT's
+       ! strains. A block that does not keep the field writes zeros.
        allocate(values(n, solver%ncomp))
        values = 0
        do ib = 1, solver%n_blocks
           associate (b => solver%blocks(ib))
-            if (size(b%log_strain, 1) == b%count) then
-               allocate(block_values(b%count, solver%ncomp))
-               call to_global(b%count, solver%ndim, solver%ncomp, b%rotation, b%log_strain, block_values)
-               values(b%first:b%first + b%count - 1, :) = block_values
-               deallocate(block_values)
+            if (name == 'LE') then
+               call rotated_block_strain(b, b%log_strain)
+            else
+               call rotated_block_strain(b, b%plastic_strain)
             end if
           end associate
        end do
-       call field_writer_element_field(out%fields, 'LE', solver%part%elem_global, values)
+       call field_writer_element_field(out%fields, name, solver%part%elem_global, values)
     case ('PEEQ', 'SDV')
        ns = 0
        do ib = 1, solver%n_blocks
@@ -309,6 +308,18 @@ contains
        values = 1
        call field_writer_element_field(out%fields, 'STATUS', solver%part%elem_global, values)
     end select
+  contains
+
+    subroutine rotated_block_strain(b, strain)
+      type(element_block_t), intent(in) :: b
+      real(dp), intent(in) :: strain(:, :)
+
+      if (size(strain, 1) /= b%count) return
+      allocate(block_values(b%count, solver%ncomp))
+      call to_global(b%count, solver%ndim, solver%ncomp, b%rotation, strain, block_values)
+      values(b%first:b%first + b%count - 1, :) = block_values
+      deallocate(block_values)
+    end subroutine rotated_block_strain
   end subroutine write_element_variable
 
   !> Global energies [ALLKE, ALLIE, ALLVD, ALLFD, ALLWK, ALLAE] at t_{n+1}; ALLIE includes ALLAE

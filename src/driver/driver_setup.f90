@@ -146,12 +146,19 @@ contains
       blk%force_hg = 0
       ! LE is kept where a VUSDFLD will ask for it, and everywhere when a step writes it (before,
       ! only the former: a requested LE field of any other material was silently all zeros).
-      if ((user_field_active .and. mat%user_field) .or. log_strain_requested(m)) then
+      if ((user_field_active .and. mat%user_field) .or. element_variable_requested(m, 'LE')) then
          allocate(blk%log_strain(nb, solver%ncomp))
       else
          allocate(blk%log_strain(0, solver%ncomp))
       end if
       blk%log_strain = 0
+      ! PE is integrated only when a step writes it (driver_plastic_strain).
+      if (element_variable_requested(m, 'PE')) then
+         allocate(blk%plastic_strain(nb, solver%ncomp))
+      else
+         allocate(blk%plastic_strain(0, solver%ncomp))
+      end if
+      blk%plastic_strain = 0
       allocate(xe(nb, nd, ne))
       do e = 1, nb
          blk%elem_number(e) = m%mesh%elem_id(part%elem_global(blk%first + e - 1))
@@ -207,20 +214,21 @@ contains
     call assemble_element_vectors(solver%part, solver%ndim, solver%fe, solver%f_int)
   end subroutine initial_internal_forces
 
-  !> Does any step write the LE field?
-  pure logical function log_strain_requested(m)
+  !> Does any step write the element field `name` (LE, PE)?
+  pure logical function element_variable_requested(m, name) result(requested)
     type(model_t), intent(in) :: m
+    character(len=*), intent(in) :: name
     integer :: i, j
 
-    log_strain_requested = .false.
+    requested = .false.
     do i = 1, m%n_steps
        if (.not. allocated(m%steps(i)%field_outputs)) cycle
        do j = 1, size(m%steps(i)%field_outputs)
           if (.not. allocated(m%steps(i)%field_outputs(j)%element_variables)) cycle
-          if (any(m%steps(i)%field_outputs(j)%element_variables == 'LE')) log_strain_requested = .true.
+          if (any(m%steps(i)%field_outputs(j)%element_variables == name)) requested = .true.
        end do
     end do
-  end function log_strain_requested
+  end function element_variable_requested
 
   !> Block and position of local element le.
   pure subroutine locate(solver, le, ib, e)

@@ -33,6 +33,7 @@ module driver_solver
      real(dp), allocatable :: field(:, :)             !< (count, nfieldv) field variables at t_n
      real(dp), allocatable :: e_int(:), e_inel(:)     !< specific energies (per unit mass)
      real(dp), allocatable :: log_strain(:, :)        !< accumulated corotational strain (LE)
+     real(dp), allocatable :: plastic_strain(:, :)    !< corotational plastic strain (PE); (0, ncomp) unless written
      real(dp), allocatable :: sigma_bv(:)             !< bulk-viscosity pressure of the last increment
      real(dp), allocatable :: force_hg(:, :, :)       !< (count, ndim, nen) hourglass forces at t_n
      real(dp) :: wave_modulus = 0                     !< λ + 2G from the packaging call

@@ -374,6 +374,24 @@ contains
        end do
        blk%params = [blk%params, p]
     end do
+    ! *HISTORY OUTPUT is what Abaqus/CAE calls a history output request; the input file
+    ! keyword is *OUTPUT, HISTORY. Both are read as the latter (docs/keywords.md).
+    if (blk%name == 'HISTORY OUTPUT') then
+       do j = 1, size(blk%params)
+          if (blk%params(j)%name == 'FIELD' .or. blk%params(j)%name == 'HISTORY') then
+             call raise_error(file, line, '*HISTORY OUTPUT takes no ' // blk%params(j)%name // &
+                  ' parameter; expected *HISTORY OUTPUT[, TIME INTERVAL=t | NUMBER INTERVAL=n] ' // &
+                  '(the same as *OUTPUT, HISTORY)', err)
+             return
+          end if
+       end do
+       blk%name = 'OUTPUT'
+       p%name = 'HISTORY'
+       p%value = ''
+       p%has_value = .false.
+       p%quoted = .false.
+       blk%params = [blk%params, p]
+    end if
   end subroutine parse_keyword_line
 
   !> Split on commas outside double quotes; fields trimmed; a trailing empty field

@@ -226,10 +226,43 @@ def check_patch(p, run: Run) -> dict[str, float]:
     report('stress non-uniformity max |S_e - mean|/|mean|', figures['uniformity'], 1e-8, '', '.2e')
     report('stress vs lambda tr(E) I + 2G E, E = log(I + L t)', figures['stress'], 1e-8, '', '.2e')
     report('LE of every element vs log(I + L t)', figures['log_strain'], 1e-8, '', '.2e')
+    if 'PE' in last.fields:
+        figures['plastic_strain'] = float(np.max(np.abs(last.fields['PE'])))
+        report('largest |PE| of the elastic patch', figures['plastic_strain'], 1e-12, '', '.2e')
     if 'A' in last.fields:
         a = np.max(np.abs(last.fields['A']))
         v = np.max(np.abs(last.fields['V']))
         report('largest acceleration x t / largest velocity', a * t / v, 1e-8, '', '.2e')
+    return figures
+
+
+def compliance(stress: np.ndarray, e: float, nu: float) -> np.ndarray:
+    """C^-1 sigma of rows of stress components (11, 22, 33, 12[, 23, 31]); tensor shears."""
+    eps = np.empty_like(stress)
+    trace = stress[:, :3].sum(axis=1)
+    eps[:, :3] = ((1 + nu) * stress[:, :3] - nu * trace[:, None]) / e
+    eps[:, 3:] = (1 + nu) / e * stress[:, 3:]
+    return eps
+
+
+def check_plastic_patch(p, run: Run) -> dict[str, float]:
+    """PE of a homogeneous patch driven through yield: the driver's Δε − C⁻¹Δσ against the
+    material's own volumetric plastic strain EVP (SDV2), uniformity, and PE = LE − C⁻¹σ."""
+    e, nu = float(p['E']), float(p['nu'])
+    last = read_fields(run.h5).frames[-1]
+    pe, le, s = last.fields['PE'], last.fields['LE'], last.fields['S']
+    peeq, evp = last.fields['PEEQ'].ravel(), last.fields['SDV2'].ravel()
+    scale = np.max(np.abs(pe))
+    print(f'  t = {last.total_time:.4g} s: PE = {np.array2string(pe.mean(axis=0), precision=6)}, '
+          f'PEEQ = {peeq.mean():.5g}, EVP = {evp.mean():.5g}, yield region SDV5 = {last.fields["SDV5"].ravel()}')
+    if not (peeq.min() > 1e-4 and evp.min() > 0):
+        raise CheckFailed(f'the patch did not flow plastically with dilation (PEEQ {peeq.min():.3g}, EVP {evp.min():.3g})')
+    figures = {'trace_vs_evp': float(np.max(np.abs(pe[:, :3].sum(axis=1) - evp)) / np.max(np.abs(evp))),
+               'uniformity': float(np.max(np.abs(pe - pe.mean(axis=0))) / scale),
+               'decomposition': float(np.max(np.abs(le - compliance(s, e, nu) - pe)) / scale)}
+    report('tr PE vs the material\'s EVP (SDV2), relative', figures['trace_vs_evp'], 1e-9, '', '.2e')
+    report('PE non-uniformity max |PE_e - mean| / max |PE|', figures['uniformity'], 1e-8, '', '.2e')
+    report('PE vs LE - C^-1 S, relative to max |PE|', figures['decomposition'], 1e-8, '', '.2e')
     return figures
 
 
@@ -278,7 +311,8 @@ def check_sections(p, run: Run) -> dict[str, float]:
 
 
 CHECKS = {'wave': check_wave, 'column': check_column, 'incline': check_incline, 'patch': check_patch,
-          'dynamic': check_dynamic, 'sections': check_sections, 'rotation': check_rotation}
+          'dynamic': check_dynamic, 'sections': check_sections, 'rotation': check_rotation,
+          'plastic_patch': check_plastic_patch}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -292,12 +326,26 @@ def cmd_verify(args, launcher: Launcher) -> None:
     print(f'{args.scene.name}: {kind}, {p.get("ndim")}D')
     run = launcher.run(args.scene, args.workdir / args.scene.stem)
     CHECKS[kind](p, run)
+    check_plastic_strain_trace(run)
     # The hourglass share is meaningless where the hourglass mode is the point of the scene.
     check_energy(read_history(run.history_csv), check_artificial=kind != 'sections')
     check_no_balance_warning(run)
     check_no_nan(run)
     present, absent = expected_effects(args.scene)
     check_effects(run, present, absent)
+
+
+def check_plastic_strain_trace(run: Run) -> None:
+    """Wherever a scene writes PE and the state variables, tr PE (the driver's) equals EVP = SDV2
+    (the material's) in every frame; elements of a material without SDVs write SDV2 = 0, and
+    their PE must stay zero too."""
+    fields = read_fields(run.h5)
+    frames = [f for f in fields.frames if 'PE' in f.fields and 'SDV2' in f.fields]
+    if not frames:
+        return
+    worst = max(float(np.max(np.abs(f.fields['PE'][:, :3].sum(axis=1) - f.fields['SDV2'].ravel()))) for f in frames)
+    scale = max(float(np.max(np.abs(f.fields['PE']))) for f in frames) + 1e-30
+    report(f'tr PE vs SDV2 over {len(frames)} frames, relative to max |PE|', worst / scale, 1e-9, '', '.2e')
 
 
 def final_arrays(run: Run) -> dict[str, np.ndarray]:
