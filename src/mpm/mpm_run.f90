@@ -80,6 +80,13 @@ module mpm_run
      real(dp) :: e_kinetic = 0, e_internal = 0, w_external = 0, e_walls = 0, e_damping = 0
      real(dp) :: e_out = 0, e_in = 0                 !< w_external, e_out: rank (e_kinetic, e_internal: global after measure)
      real(dp), allocatable :: wall_force(:, :)       !< (3, n_walls) force of the material on each wall
+     !> Impulse of the material on each wall since the last history row, and the time it took.
+     !> The history reports impulse / time: the force of one increment, m Δv/Δt at the wall
+     !> nodes, also removes the normal velocity the nodes brought into the increment, so it
+     !> scales with 1/Δt; a short final increment made it 2-3.5 times too large.
+     real(dp), allocatable :: wall_impulse(:, :)
+     real(dp), allocatable :: wall_force_row(:, :)   !< the last history row's (mean) wall forces
+     real(dp) :: impulse_time = 0
      logical, allocatable :: on_wall(:)              !< grid nodes of the walls active in this step
      ! time
      integer :: step = 0, increment = 0
@@ -370,7 +377,10 @@ contains
          st%nblocks = s
       end if
       allocate (st%wall_nodes(size(mpm%walls)), st%wall_force(3, size(mpm%walls)))
+      allocate (st%wall_impulse(3, size(mpm%walls)), st%wall_force_row(3, size(mpm%walls)))
       st%wall_force = 0
+      st%wall_impulse = 0
+      st%wall_force_row = 0
       do k = 1, size(mpm%walls)
          call wall_find_nodes(mpm%walls(k), st%g, st%wall_nodes(k))
       end do
@@ -609,6 +619,8 @@ contains
           call wall_project(m%mpm%walls(k), st%wall_nodes(k), st%nd, st%g%mass, st%g%active, st%g%v_new, &
                st%dt, st%wall_force(:, k), st%e_walls)
        end do
+       st%wall_impulse = st%wall_impulse + st%dt * st%wall_force
+       st%impulse_time = st%impulse_time + st%dt
        call timer_stop(fx%timers, fx%id(fx_walls))
     end if
 
@@ -1230,7 +1242,7 @@ contains
   !> One history row: global values (sums over ranks in rank order; collective).
   subroutine write_history(m, st, hist, last_time, last_out)
     type(model_t), intent(in) :: m
-    type(mpm_state_t), intent(in) :: st
+    type(mpm_state_t), intent(inout) :: st
     type(history_t), intent(inout) :: hist
     real(dp), intent(inout) :: last_time, last_out
     real(dp), allocatable :: row(:)
@@ -1269,9 +1281,16 @@ contains
          st%e_internal, g(10), st%e_walls, st%e_damping, etotal, xcm, vcm, top(1), g(12)]
     j = 24
     do k = 1, size(m%mpm%walls)
-       row(j + 1:j + 3) = st%wall_force(:, k)
+       if (st%impulse_time > 0) then
+          st%wall_force_row(:, k) = st%wall_impulse(:, k) / st%impulse_time
+       else
+          st%wall_force_row(:, k) = st%wall_force(:, k)
+       end if
+       row(j + 1:j + 3) = st%wall_force_row(:, k)
        j = j + 3
     end do
+    if (allocated(st%wall_impulse)) st%wall_impulse = 0
+    st%impulse_time = 0
     call history_row(hist, row)
     last_time = st%total_time
     last_out = mass_out
@@ -1328,7 +1347,7 @@ contains
     write (output_unit, '(a,5es12.4)') '  energies  ALLKE ALLIE ALLWK ALLFD ALLDMD:', st%e_kinetic, st%e_internal, &
          g(5), st%e_walls, st%e_damping
     do k = 1, size(m%mpm%walls)
-       write (output_unit, '(a,3es13.5)') '  wall ' // trim(m%mpm%walls(k)%name) // ' force:', st%wall_force(:, k)
+       write (output_unit, '(a,3es13.5)') '  wall ' // trim(m%mpm%walls(k)%name) // ' force:', st%wall_force_row(:, k)
     end do
     if (g(6) > 0) write (output_unit, '(a,i0)') '  particles put back onto walls: ', nint(g(6))
     rate = g(7) / max(st%loop_seconds, 1.0e-9_dp)
