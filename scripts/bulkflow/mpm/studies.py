@@ -51,6 +51,18 @@ def add_common(p, name):
     p.add_argument("--no-reuse", action="store_true", help="run every case again")
 
 
+def add_case_arguments(p, cell=0.05, discharge=1.5, field_frames=None, skip=None,
+                       skip_help="average discharge frames from this time after opening [s]"):
+    """The options every study's runs share: cell, discharge time and, where the study uses them,
+    the particle frames per step and the time after opening that is left out."""
+    p.add_argument("--cell", type=float, default=cell, help="grid cell [m]")
+    p.add_argument("--discharge", type=float, default=discharge, help="discharge time [s] after the 1 s fill")
+    if field_frames is not None:
+        p.add_argument("--field-frames", type=int, default=field_frames, help="particle frames per step")
+    if skip is not None:
+        p.add_argument("--skip", type=float, default=skip, help=skip_help)
+
+
 def case(a, **scene):
     """One run of a study (shared across studies through a.runs)."""
     return run_hopper(a.bulkflow, a.runs, reuse=not a.no_reuse, **scene)
@@ -63,7 +75,8 @@ def _profiles(r, frames_used=3):
     with h5py.File(r["base"] + ".h5", "r") as f:
         groups = frames(f, frames_used)
         op = outlet_path(groups, sc["cell"], sc.get("theta", 30.0), sc.get("outlet", 0.25))
-        wp = wall_path(groups, sc["cell"], sc.get("theta", 30.0), sc.get("outlet", 0.25))
+        # bins of 0.1 m whatever the cell, so profiles of different resolutions compare bin for bin
+        wp = wall_path(groups, sc["cell"], sc.get("theta", 30.0), sc.get("outlet", 0.25), bin_width=0.1)
     return op, wp
 
 
@@ -84,9 +97,14 @@ def convergence(a):
     """Study a and item 6: grid size, particles per cell and shape functions against the steady
     MDR, the outlet centre velocity, the outlet v_y profile and the discharging wall normal stress
     (thesis Fig. 4.7), with the wall time of each run."""
-    cases = [(c, a.ppc, a.shape) for c in a.cells]
-    cases += [(a.variant_cell, p, a.shape) for p in a.ppcs if (a.variant_cell, p, a.shape) not in cases]
-    cases += [(a.variant_cell, a.ppc, sh) for sh in a.shapes if (a.variant_cell, a.ppc, sh) not in cases]
+    # Every cell puts the outlet edge mid-cell (x = b/2 = (k + 1/2) h): where the edge falls in a
+    # cell decides how the outlet corner is resolved, and mixing offsets made the series jump by
+    # +-18 % (cells 0.1/0.07/0.05/0.035 m: offsets 0.25/0.79/0.5/0.57). --cells overrides.
+    cells = a.cells or [0.125 / n for n in a.edge_cells]
+    variant = cells[[abs(c - a.variant_cell) for c in cells].index(min(abs(c - a.variant_cell) for c in cells))]
+    cases = [(c, a.ppc, a.shape) for c in cells]
+    cases += [(variant, p, a.shape) for p in a.ppcs if (variant, p, a.shape) not in cases]
+    cases += [(variant, a.ppc, sh) for sh in a.shapes if (variant, a.ppc, sh) not in cases]
     rows = []
     for cell, ppc, shape in cases:
         r = case(a, cell=cell, ppc=ppc, discharge_time=a.discharge, shape=shape)
@@ -111,7 +129,7 @@ def convergence(a):
                    d_v_centre=r["v_centre"] / ref["v_centre"] - 1, rho_out=r["rho_out"], mfi=r["mfi"],
                    d_outlet_profile=dv_prof, d_wall_stress=dsig)
         table.append(row)
-        print(f"{row['cell']:6.3f} {row['ppc']:3d} {row['shape']:>6} {row['particles']:9d} {row['wall_s']:7.1f} "
+        print(f"{row['cell']:6.4f} {row['ppc']:3d} {row['shape']:>6} {row['particles']:9d} {row['wall_s']:7.1f} "
               f"{row['mdr_full']:10.1f} {row['d_mdr']:+7.3f} {row['v_centre']:8.3f} {row['d_v_centre']:+7.3f} "
               f"{row['rho_out']:7.1f} {row['mfi']:5.2f} {dv_prof:7.3f} {dsig:7.3f}")
     print("MDR: full hopper (twice the half model) per metre of depth; v_c: outlet centre velocity; d*: relative to "
@@ -139,7 +157,7 @@ def convergence(a):
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.5))
     for r in rows:
         lab = f"h={r['cell']:g} m, {r['ppc']} PPC, {r['shape']}"
-        ax[0].plot(r["outlet_profile"][:, 0] / (0.5 * r["scene"]["outlet"]), -r["outlet_profile"][:, 1], "o-",
+        ax[0].plot(r["outlet_profile"][:, 0] / (0.5 * r["scene"].get("outlet", 0.25)), -r["outlet_profile"][:, 1], "o-",
                    ms=3, label=lab)
         ax[1].plot(r["wall_profile"][:, 2] / 1e3, r["wall_profile"][:, 1], "-", label=lab)
         ax[2].loglog([r["wall"]], [abs(r["mdr"] / ref["mdr"] - 1) + 1e-4], "o")
@@ -178,9 +196,12 @@ def main(argv=None):
                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
     sub = p.add_subparsers(dest="study", required=True)
     c = sub.add_parser("convergence", help="grid convergence and accuracy vs cost (a, item 6)")
-    c.add_argument("--cells", type=float, nargs="+", default=[0.1, 0.07, 0.05, 0.035])
+    c.add_argument("--edge-cells", type=float, nargs="+", default=[1.5, 2.5, 3.5, 4.5],
+                   help="outlet half-width b/2 = 0.125 m in cells (k + 1/2: the edge mid-cell)")
+    c.add_argument("--cells", type=float, nargs="+", help="cell sizes instead of --edge-cells")
     c.add_argument("--ppc", type=int, default=2, help="particles per cell direction of the cell series")
-    c.add_argument("--variant-cell", type=float, default=0.05, help="cell of the PPC and shape variants")
+    c.add_argument("--variant-cell", type=float, default=0.05,
+                   help="the PPC and shape variants run at the series' cell nearest to this")
     c.add_argument("--ppcs", type=int, nargs="+", default=[3], help="other PPCs at --variant-cell")
     c.add_argument("--shapes", nargs="+", default=["LINEAR"], choices=["GIMP", "LINEAR"],
                    help="other shape functions at --variant-cell")
@@ -189,7 +210,7 @@ def main(argv=None):
     s.add_argument("--thetas", type=float, nargs="+", default=[15.0, 30.0, 45.0])
     s.add_argument("--cell", type=float, default=0.05)
     for name, q in (("convergence", c), ("sweep", s)):
-        q.add_argument("--discharge", type=float, default=1.5)
+        q.add_argument("--discharge", type=float, default=1.5, help="discharge time [s] after the 1 s fill")
         q.add_argument("--shape", choices=["GIMP", "LINEAR"], default="GIMP")
         add_common(q, name)
     runners = {"convergence": convergence, "sweep": sweep}

@@ -34,8 +34,8 @@ SERIES = {"theta": ("theta", (5.0, 60.0)), "phi_w": ("wall_friction", (0.0, None
 
 
 def add_arguments(p):
-    p.add_argument("--cell", type=float, default=0.05)
-    p.add_argument("--discharge", type=float, default=1.5, help="discharge time [s] (with inflow)")
+    from .studies import add_case_arguments
+    add_case_arguments(p)
     p.add_argument("--thetas", type=float, nargs="+", default=[20.0, 25.0, 30.0, 35.0, 40.0])
     p.add_argument("--phi-ws", type=float, nargs="+", default=[5.0, 10.0, 15.0, 20.0, 25.0])
     p.add_argument("--phis", type=float, nargs="+", default=[20.0, 25.0, 30.0, 35.0, 40.0])

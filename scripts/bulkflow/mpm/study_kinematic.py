@@ -78,13 +78,8 @@ def grows(values):
 
 
 def add_arguments(p):
-    p.add_argument("--cell", type=float, default=CASE_DEFAULTS["cell"])
-    p.add_argument("--discharge", type=float, default=CASE_DEFAULTS["discharge"],
-                   help="discharge time [s] after the 1 s fill")
-    p.add_argument("--field-frames", type=int, default=CASE_DEFAULTS["field_frames"],
-                   help="particle frames per step")
-    p.add_argument("--skip", type=float, default=CASE_DEFAULTS["skip"],
-                   help="average discharge frames from this time after opening [s]")
+    from .studies import add_case_arguments
+    add_case_arguments(p, **CASE_DEFAULTS)
     p.add_argument("--heights", type=float, nargs="+", default=HEIGHTS, help="heights above the outlet [m]")
     p.add_argument("--xbin", type=float, default=1.0, help="bin width across the hopper in cells")
     p.add_argument("--wall-gap", type=float, default=1.0,

@@ -98,13 +98,8 @@ def compare(mc, dp, a, geo=TABLE_4_2):
 
 
 def add_arguments(p):
-    p.add_argument("--cell", type=float, default=CASE_DEFAULTS["cell"])
-    p.add_argument("--discharge", type=float, default=CASE_DEFAULTS["discharge"],
-                   help="discharge time [s] after the 1 s fill")
-    p.add_argument("--field-frames", type=int, default=CASE_DEFAULTS["field_frames"],
-                   help="particle frames per step")
-    p.add_argument("--skip", type=float, default=CASE_DEFAULTS["skip"],
-                   help="average discharge frames from this time after opening [s]")
+    from .studies import add_case_arguments
+    add_case_arguments(p, **CASE_DEFAULTS)
     p.add_argument("--psi", type=float, nargs="+", default=[0.0, 10.0],
                    help="constant dilation angles of the MC/DP pairs [deg] (0 = thesis eq. 3.2)")
     p.add_argument("--no-context", action="store_true",

@@ -31,10 +31,9 @@ CASES = (("psi 15->0 table", dict()), ("psi 10 constant", dict(psi_constant=10.0
 
 
 def add_arguments(p):
-    p.add_argument("--cell", type=float, default=0.05)
-    p.add_argument("--discharge", type=float, default=3.0, help="discharge time [s] (with inflow)")
+    from .studies import add_case_arguments
+    add_case_arguments(p, discharge=3.0, skip=0.5, skip_help="s after opening left out of the trend fits")
     p.add_argument("--window", type=float, default=0.2, help="MDR window [s]")
-    p.add_argument("--skip", type=float, default=0.5, help="s after opening left out of the trend fits")
     p.add_argument("--frame-dt", type=float, default=0.1, help="particle frame interval in the discharge [s]")
 
 

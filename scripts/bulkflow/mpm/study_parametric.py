@@ -56,9 +56,8 @@ PARAMS = {
 
 
 def add_arguments(p):
-    p.add_argument("--cell", type=float, default=0.05)
-    p.add_argument("--discharge", type=float, default=1.5, help="discharge time [s] (with inflow)")
-    p.add_argument("--skip", type=float, default=0.5, help="s after opening left out of the MDR")
+    from .studies import add_case_arguments
+    add_case_arguments(p, skip=0.5, skip_help="s after opening left out of the MDR")
     p.add_argument("--young", type=float, nargs="+", default=[5.0, 10.0, 20.0], help="E values [MPa]")
     p.add_argument("--phi", type=float, nargs="+", default=[25.0, 30.0, 35.0], help="phi values [deg]")
     p.add_argument("--phi-w", type=float, nargs="+", default=[10.0, 15.0, 20.0], help="phi_w values [deg]")

@@ -25,8 +25,12 @@ edge x = b/2 lies at b/(2h) cells from the axis; its fractional part (0 for b = 
 h = 0.05 m, 0.5 for 0.15, 0.25, 0.35, 0.45 m) decides how the corner between the outlet and the
 wall is resolved, the resolution effect src/mpm/README.md notes for the convergence runs. The b fit
 is therefore also made on the widths whose edge has the same offset as the base case b = 0.25 m
-(the "grid-consistent" subset), and the offset is listed per point.
+(the "grid-consistent" subset), and the offset is listed per point. With `--align-edge` (the
+default) every width is run at the cell nearest to `--cell` that puts its edge mid-cell
+(hopper_scene.aligned_cell: b = 0.20 m at h = 0.04 m, 0.30 m at 0.0429 m), so all widths are
+grid-consistent; `--no-align-edge` runs them all at `--cell` and shows the artefact.
 """
+import argparse
 import csv
 import json
 import math
@@ -35,19 +39,22 @@ import numpy as np
 from scipy import stats
 
 from ..theory.beverloo import rose_tanaka_factor
+from .hopper_scene import aligned_cell
 
 G = 9.81
 
 
 def add_arguments(p):
-    p.add_argument("--cell", type=float, default=0.05)
-    p.add_argument("--discharge", type=float, default=1.5, help="discharge time [s] (with inflow)")
+    from .studies import add_case_arguments
+    add_case_arguments(p)
     p.add_argument("--outlets", type=float, nargs="+", default=[0.15, 0.20, 0.25, 0.30, 0.35, 0.45],
                    help="b [m]")
     p.add_argument("--theta-b", type=float, default=30.0, help="half angle of the b series [deg]")
     p.add_argument("--thetas", type=float, nargs="+", default=[10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0],
                    help="half angles [deg]")
     p.add_argument("--b-theta", type=float, default=0.25, help="outlet width of the theta series [m]")
+    p.add_argument("--align-edge", action=argparse.BooleanOptionalAction, default=True,
+                   help="run each width at the cell nearest --cell that puts the outlet edge mid-cell")
     p.add_argument("--phi-d", type=float, default=45.0,
                    help="Rose-Tanaka stagnant-zone angle: theta fit only below 90 - phi_d [deg]")
 
@@ -99,8 +106,9 @@ def run(a):
     rows = []
     todo = [("b", a.theta_b, b) for b in a.outlets] + [("theta", t, a.b_theta) for t in a.thetas]
     for series, theta, b in todo:
-        r = case(a, cell=a.cell, discharge_time=a.discharge, theta=theta, outlet=b)
-        rows.append(dict(series=series, theta=theta, b=b, tan_theta=math.tan(math.radians(theta)),
+        cell = aligned_cell(a.cell, b) if a.align_edge else a.cell
+        r = case(a, cell=cell, discharge_time=a.discharge, theta=theta, outlet=b)
+        rows.append(dict(series=series, theta=theta, b=b, cell=cell, tan_theta=math.tan(math.radians(theta)),
                          particles=r["particles"], wall=r["wall"], mdr=r["mdr_full"], rho_out=r["rho_out"],
                          v_out=r["v_out"], mfi=r["mfi"], C=r["mdr_full"] / (r["rho_out"] * math.sqrt(G) * b ** 1.5),
                          F_RT=rose_tanaka_factor(theta, a.phi_d), base=r["base"]))
@@ -109,7 +117,7 @@ def run(a):
     theta_max = 90.0 - a.phi_d
     for r in rows:
         r["in_fit"] = bool(r["mfi"] > 0.3 and (r["series"] == "b" or r["theta"] < theta_max))
-        r["edge_offset"] = edge_offset(r["b"], a.cell)
+        r["edge_offset"] = edge_offset(r["b"], r["cell"])
     print(f"\n{'series':>6} {'theta':>6} {'b m':>5} {'tan':>6} {'parts':>6} {'wall s':>6} {'MDR':>8} {'rho_out':>8} "
           f"{'MDR/rho':>8} {'C':>6} {'MFI':>6} {'F_RT':>5} {'edge':>4} fit")
     for r in rows:
@@ -128,7 +136,8 @@ def run(a):
     fits["tan"] = power_law_fit([r["tan_theta"] for r in ts], [r["mdr"] for r in ts])
     fits["tan_rho"] = power_law_fit([r["tan_theta"] for r in ts], [r["mdr"] / r["rho_out"] for r in ts])
     # grid-consistent subset: outlet edge at the same offset from a node line as the base case
-    off0 = edge_offset(a.b_theta, a.cell)
+    off0 = edge_offset(a.b_theta, aligned_cell(a.cell, a.b_theta) if a.align_edge else a.cell)
+    fits["edge_offset_base"] = off0
     bg = [r for r in bs if abs(r["edge_offset"] - off0) < 1e-6]
     fits["b_grid"] = power_law_fit([r["b"] for r in bg], [r["mdr"] for r in bg])
     fits["b_rho_grid"] = power_law_fit([r["b"] for r in bg], [r["mdr"] / r["rho_out"] for r in bg])
@@ -166,7 +175,7 @@ def run(a):
           + ", ".join(f"{q['theta_lo']:g}-{q['theta_hi']:g}: {q['m_local']:+.2f}" for q in local))
 
     out = a.out
-    cols = ["series", "theta", "b", "tan_theta", "particles", "wall", "mdr", "rho_out", "v_out", "mfi", "C", "F_RT",
+    cols = ["series", "theta", "b", "cell", "tan_theta", "particles", "wall", "mdr", "rho_out", "v_out", "mfi", "C", "F_RT",
             "edge_offset", "in_fit", "base"]
     with open(f"{out}/rate_fit.csv", "w", newline="") as f:
         w = csv.writer(f)
@@ -215,7 +224,7 @@ def _plot(rows, fits, a, path):
                 ax[j].plot(xx, fg["prefactor"] * xx ** fg["exponent"] / norm, ":", c=col, lw=1.2,
                            label=f"fit, edge offset as b = {a.b_theta:g}: {fg['exponent']:+.3f} +- {fg['ci']:.3f}")
                 for xi, yi, r in zip(x, y, g):
-                    if abs(r["edge_offset"] - edge_offset(a.b_theta, a.cell)) > 1e-6:
+                    if abs(r["edge_offset"] - fits["edge_offset_base"]) > 1e-6:
                         ax[j].annotate(f"edge offset {r['edge_offset']:g}", (xi, yi), fontsize=7, xytext=(4, -10),
                                        textcoords="offset points")
             if series == "theta" and q == "mdr":
@@ -232,7 +241,9 @@ def _plot(rows, fits, a, path):
     ax[0].set_ylabel("rate / fit at mid-range [-]")
     ax[0].set_title(f"(a) vs outlet width, theta = {a.theta_b:g} deg (cf. Fig. 4.15a)", fontsize=10)
     ax[1].set_title(f"(b) vs half angle, b = {a.b_theta:g} m (cf. Fig. 4.15b)", fontsize=10)
-    fig.suptitle(f"MPM wedge hopper, Table 4.2 material, cell {a.cell:g} m: MDR power laws (95 % intervals)",
+    fig.suptitle(f"MPM wedge hopper, Table 4.2 material, cell {a.cell:g} m"
+                 f"{' (each width at the cell that puts its outlet edge mid-cell)' if a.align_edge else ''}: "
+                 "MDR power laws (95 % intervals)",
                  fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

@@ -10,15 +10,15 @@ outlet closed + `--discharge` s with the outlet open and inflow at the top) give
 
 both along the inclined wall in wall coordinates (sigma_n = -n.S.n, compression positive), in
 bins of `--bin` cells along the wall, from the particles 1-2 cells from the wall line (`--band`).
-Why not the particles within one cell, as paths.py: the cell the inclined wall cuts carries the
+Why not the particles within one cell of the wall line (paths.py before it took this band too): the cell the inclined wall cuts carries the
 node-only wall's artefact. At cell 0.05 m the half-cell row next to the wall carries ~1.9x, the
 next row ~0.8x the sigma_n found one cell further in (fill), and along the wall sigma_n swings
 with a period of 7 cells in height (autocorrelation 0.64 at lag 7; tan 30 deg ~ 4/7: the node
 pattern next to the wall line repeats every 7 cells up); the same pattern shows for MC and DP alike
 (study g), i.e. it is geometric, not material. One cell further in the stress is smoother, and
 integrated along the wall it matches the solver's wall reaction force (printed: within 1 % in
-filling, 4 % in discharge at cell 0.05 m), while the paths.py band overshoots it by 20-30 %.
-The paths.py band is reduced and reported too.
+filling, 4 % in discharge at cell 0.05 m), while the within-one-cell band overshoots it by 20-30 %.
+The within-one-cell band is reduced and reported too ("cut cell").
 
 Theory ("modified Walker", thesis §4.5.4). The thesis means Walker's method of differential
 slices with Walters' distribution factor (thesis §1.2, its ref. 18). Walters' factor for HOPPERS
@@ -52,15 +52,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .paths import WALL_BAND, wall_geometry, wall_stress_profile  # noqa: F401 (also this module's API)
+
 from ..theory.walker import walker_D, wall_normal_stress
 
 # the case studies c and d share (and mc-dp, for its context row): more discharge frames than the
 # hopper_run default so that the discharge averages have 8 frames past the start-up transient
 CASE_DEFAULTS = dict(cell=0.05, discharge=2.0, field_frames=10, skip=0.6)
 TABLE_4_2 = dict(theta=30.0, outlet=0.25, height=3.0, phi=20.0, wall_friction=5.0, density=1600.0)
-# particles 1-2 cells from the wall line: the cell the inclined wall cuts carries the node-wall
-# artefact (module doc), one cell further in the stress is smooth
-WALL_BAND = (1.0, 2.0)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -81,51 +80,6 @@ def split_frames(groups, skip):
 
 def all_frames(h5):
     return [h5["particles"][k] for k in sorted(h5["particles"].keys())]
-
-
-def wall_geometry(theta, outlet):
-    """Outlet edge x0, unit tangent up the wall, unit normal into the material (paths.py)."""
-    t = math.radians(theta)
-    x0 = np.array([0.5 * outlet, 0.5 * outlet / math.tan(t)])
-    tang = np.array([math.sin(t), math.cos(t)])
-    nrm = np.array([-math.cos(t), math.sin(t)])
-    return x0, tang, nrm
-
-
-def wall_stress_profile(groups, h, theta, outlet, bin_width, band=(-1.0, 1.0)):
-    """Wall normal and shear stress along the inclined wall, averaged over the frames `groups`.
-
-    Particles whose distance d from the wall line (positive into the material) lies in
-    [band[0] h, band[1] h) (default (-1, 1): within one cell, as paths.wall_path) and with s >= 0
-    (s = distance along the wall from the outlet edge) are binned in s by `bin_width`; every
-    particle of every frame has equal weight. sigma_n = -n.S.n (compression positive),
-    tau = t.S.n. Returns dict of arrays: s (bin centre), y (height above the apex of the wall
-    point at the bin centre), sigma_n, tau, count (particles per frame); bins without particles
-    are dropped."""
-    x0, tang, nrm = wall_geometry(theta, outlet)
-    sums = {}
-    for g in groups:
-        x, S = g["coordinates"][:][:, :2], g["S"][:]
-        rel = x - x0
-        d = rel @ nrm
-        s = rel @ tang
-        near = (d >= band[0] * h) & (d < band[1] * h) & (s >= 0)
-        sxx, syy, sxy = S[near, 0], S[near, 1], S[near, 3]
-        sn = -(nrm[0] ** 2 * sxx + nrm[1] ** 2 * syy + 2 * nrm[0] * nrm[1] * sxy)
-        ts = tang[0] * nrm[0] * sxx + tang[1] * nrm[1] * syy + (tang[0] * nrm[1] + tang[1] * nrm[0]) * sxy
-        k = np.floor(s[near] / bin_width).astype(int)
-        for kk, a, b in zip(k, sn, ts):
-            acc = sums.setdefault(int(kk), [0.0, 0.0, 0])
-            acc[0] += a
-            acc[1] += b
-            acc[2] += 1
-    keys = sorted(sums)
-    sc = (np.array(keys, dtype=float) + 0.5) * bin_width
-    n = np.array([sums[k][2] for k in keys], dtype=float)
-    return dict(s=sc, y=x0[1] + sc * tang[1],
-                sigma_n=np.array([sums[k][0] for k in keys]) / np.maximum(n, 1),
-                tau=np.array([sums[k][1] for k in keys]) / np.maximum(n, 1),
-                count=n / max(len(groups), 1))
 
 
 def wall_masks(s, y, h, y_top, exclude_top, bin_width):
@@ -210,13 +164,8 @@ def axis_stress_ratio(groups, h, y_edges):
 # study
 
 def add_arguments(p):
-    p.add_argument("--cell", type=float, default=CASE_DEFAULTS["cell"])
-    p.add_argument("--discharge", type=float, default=CASE_DEFAULTS["discharge"],
-                   help="discharge time [s] after the 1 s fill")
-    p.add_argument("--field-frames", type=int, default=CASE_DEFAULTS["field_frames"],
-                   help="particle frames per step")
-    p.add_argument("--skip", type=float, default=CASE_DEFAULTS["skip"],
-                   help="average discharge frames from this time after opening [s]")
+    from .studies import add_case_arguments
+    add_case_arguments(p, **CASE_DEFAULTS)
     p.add_argument("--bin", type=float, default=2.0, help="wall bin length in cells")
     p.add_argument("--band", type=float, nargs=2, default=list(WALL_BAND),
                    help="particles at distance [lo, hi) cells from the wall line (default 1 2)")
@@ -273,7 +222,7 @@ def run(a):
     y_top = y0 + geo["height"]
     h, fill, dis, f = load_frames(r["base"], a.skip)
     bw = a.bin * h
-    bands = {"main": tuple(a.band), "paths.py": (-1.0, 1.0)}
+    bands = {"main": tuple(a.band), "cut cell": (-1.0, 1.0)}
     prof = {k: wall_profiles(fill, dis, h, a.bin, b) for k, b in bands.items()}
     cmp_ = {k: compare_walker(prof[k], h, y0, y_top, a.exclude_top, bw) for k in bands}
     times = {"filling": [frame_time(g) for g in fill], "discharging": [frame_time(g) for g in dis]}
@@ -394,9 +343,9 @@ def plot(prof, cmp_, bands, times, y0, y_top, h, path, a, geo=TABLE_4_2):
                 label=f"MPM, {b[0]:g}-{b[1]:g} cells from the wall")
         ax.plot(p["y"][~inc] - y0, p["sigma_n"][~inc] / 1e3, "o", mfc="none", c="C0", ms=4,
                 label="MPM, left out of the RMS")
-        q = prof["paths.py"][key]
+        q = prof["cut cell"][key]
         ax.plot(q["y"] - y0, q["sigma_n"] / 1e3, "-", c="C1", lw=0.8, alpha=0.8,
-                label="MPM, within 1 cell (paths.py band)")
+                label="MPM, within 1 cell of the wall line (cut cell)")
         ax.axvspan(-0.02, h * math.cos(math.radians(geo["theta"])), color="0.9")
         ax.axvspan(y_top - a.exclude_top - y0, y_top - y0 + 0.05, color="0.9")
         nf = len(times[key])
