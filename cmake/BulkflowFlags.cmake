@@ -22,7 +22,13 @@ if(NOT CMAKE_Fortran_COMPILER_ID STREQUAL "GNU")
   return()
 endif()
 
-set(_bf_fortran_all -Wall -Wextra -ffree-line-length-none -ffp-contract=off)
+#   -nostdinc           keeps gfortran from pre-including glibc's math-vector-fortran.h, which
+#                       declares pow, exp, cos, ... SIMD-callable: vectorised loops then call
+#                       libmvec's variants, which differ from scalar libm in the last bits and
+#                       between SSE and AVX2 (C3D8R's hourglass |V|^(2/3): an AVX2 and a baseline
+#                       build drifted apart, and a point's result depended on its lane in the
+#                       block). Our include files come by -I, so nothing else changes.
+set(_bf_fortran_all -Wall -Wextra -ffree-line-length-none -ffp-contract=off -nostdinc)
 
 # Instruction set of optimised builds. The hot loops run over blocks of points (the VUMAT nblock
 # layout) and vectorise; AVX2 (x86-64-v3: every x86 server CPU since about 2015) holds four
