@@ -27,8 +27,18 @@ endif()
 #                       libmvec's variants, which differ from scalar libm in the last bits and
 #                       between SSE and AVX2 (C3D8R's hourglass |V|^(2/3): an AVX2 and a baseline
 #                       build drifted apart, and a point's result depended on its lane in the
-#                       block). Our include files come by -I, so nothing else changes.
-set(_bf_fortran_all -Wall -Wextra -ffree-line-length-none -ffp-contract=off -nostdinc)
+#                       block). Our include files come by -I; the compiler's own intrinsic
+#                       modules (ieee_arithmetic, ...) by -fintrinsic-modules-path, which
+#                       -nostdinc would otherwise drop.
+set(_bf_fortran_all -Wall -Wextra -ffree-line-length-none -ffp-contract=off)
+execute_process(COMMAND ${CMAKE_Fortran_COMPILER} -print-file-name=finclude
+                OUTPUT_VARIABLE _bf_finclude OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+if(IS_DIRECTORY "${_bf_finclude}")
+  list(APPEND _bf_fortran_all -nostdinc -fintrinsic-modules-path=${_bf_finclude})
+else()
+  message(STATUS "bulkflow: no finclude directory from ${CMAKE_Fortran_COMPILER}: glibc's SIMD math "
+                 "declarations stay in (results may differ in the last bits between instruction sets)")
+endif()
 
 # Instruction set of optimised builds. The hot loops run over blocks of points (the VUMAT nblock
 # layout) and vectorise; AVX2 (x86-64-v3: every x86 server CPU since about 2015) holds four
