@@ -34,7 +34,8 @@ module mpm_run
   use mpm_grid, only: grid_t, grid_init, grid_reset
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_keep, block_grow
   use mpm_shape, only: stencil_nodes_per_direction, block_stencil
-  use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance
+  use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance, &
+       wall_slide_velocity
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close
   use driver_vumat_call, only: vumat_work_t, vumat_work_init, call_material, packaging_modulus
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
@@ -1009,7 +1010,7 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     integer :: k, ib, p, nd
-    real(dp) :: x(3), d, vn, n(3)
+    real(dp) :: x(3), d, n(3)
 
     nd = st%nd
     do k = 1, size(m%mpm%walls)
@@ -1025,8 +1026,11 @@ contains
                  if (d >= 0) cycle
                  if (.not. wall_contains(w, nd, x, 0.0_dp)) cycle
                  b%x(p, :) = b%x(p, :) - d * n(1:nd)
-                 vn = dot_product(b%v(p, :), n(1:nd))
-                 if (vn < 0) b%v(p, :) = b%v(p, :) - vn * n(1:nd)
+                 ! The velocity into the wall goes, with the wall's own Coulomb law on what is
+                 ! left (wall_slide_velocity, as on the wall's nodes). A frictionless put-back
+                 ! let the particles along the inclined wall slide freely wherever many were put
+                 ! back (some cells: ~10x more), and those discharged ~40 % faster.
+                 b%v(p, :) = wall_slide_velocity(w, nd, b%v(p, :))
                  st%n_guarded = st%n_guarded + 1
               end do
             end associate

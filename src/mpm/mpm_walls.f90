@@ -22,7 +22,7 @@ module mpm_walls
      integer, allocatable :: nodes(:)
   end type wall_nodes_t
 
-  public :: wall_find_nodes, wall_project, wall_contains, wall_distance
+  public :: wall_find_nodes, wall_project, wall_contains, wall_distance, wall_slide_velocity
 
 contains
 
@@ -88,7 +88,7 @@ contains
     real(dp), intent(inout), optional :: force(3)
     real(dp), intent(inout), optional :: dissipated
     integer :: k, i
-    real(dp) :: n(3), vi(3), vn, vt(3), tn, scale, vnew(3)
+    real(dp) :: n(3), vi(3), vn, tn, scale, vnew(3)
 
     tn = 0
     scale = 1
@@ -104,11 +104,7 @@ contains
           vnew = vi - vn * n
        else
           if (vn >= 0) cycle
-          vt = vi - vn * n
-          tn = norm2(vt)
-          scale = 0
-          if (tn > 0) scale = max(0.0_dp, 1 - w%friction * abs(vn) / tn)
-          vnew = vt * scale
+          call coulomb_slide(w%friction, vi, vn, n, vnew, tn, scale)
        end if
        if (present(force)) force = force - mass(i) * (vnew - vi) / dt
        if (present(dissipated) .and. w%kind /= wall_symmetry) dissipated = dissipated + 0.5_dp * mass(i) * &
@@ -116,4 +112,41 @@ contains
        v(:, i) = vnew(1:ndim)
     end do
   end subroutine wall_project
+
+  !> A velocity after contact with the wall: the normal part into the wall removed and the
+  !> tangential part reduced by μ times it (stick when that exceeds it); a symmetry wall removes
+  !> the normal part both ways. Unchanged when it leaves a friction wall.
+  pure function wall_slide_velocity(w, ndim, v) result(vnew)
+    type(mpm_wall_t), intent(in) :: w
+    integer, intent(in) :: ndim
+    real(dp), intent(in) :: v(ndim)
+    real(dp) :: vnew(ndim)
+    real(dp) :: vi(3), vn, vo(3), tn, scale
+
+    vi = 0
+    vi(1:ndim) = v
+    vn = dot_product(vi, w%normal)
+    if (w%kind == wall_symmetry) then
+       vo = vi - vn * w%normal
+    else if (vn < 0) then
+       call coulomb_slide(w%friction, vi, vn, w%normal, vo, tn, scale)
+    else
+       vo = vi
+    end if
+    vnew = vo(1:ndim)
+  end function wall_slide_velocity
+
+  !> Coulomb's law on a velocity vi with normal part vn < 0: vnew = scale · (vi − vn n),
+  !> scale = max(0, 1 − μ|vn|/|v_t|); tn = |v_t|.
+  pure subroutine coulomb_slide(mu, vi, vn, n, vnew, tn, scale)
+    real(dp), intent(in) :: mu, vi(3), vn, n(3)
+    real(dp), intent(out) :: vnew(3), tn, scale
+    real(dp) :: vt(3)
+
+    vt = vi - vn * n
+    tn = norm2(vt)
+    scale = 0
+    if (tn > 0) scale = max(0.0_dp, 1 - mu * abs(vn) / tn)
+    vnew = vt * scale
+  end subroutine coulomb_slide
 end module mpm_walls

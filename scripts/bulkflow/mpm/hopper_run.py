@@ -25,6 +25,10 @@ from .hopper_scene import hopper_scene
 from .paths import frames, outlet_path
 
 DEFAULT_EXE = str(Path(__file__).resolve().parents[3] / "build" / "bin" / "bulkflow")
+# Bumped whenever the MPM solver's physics changes, so cached runs of an older solver are not
+# read back as this one's (part of every run's name). 1: session 2's solver; 2: the particle
+# put-back behind a wall applies the wall's Coulomb friction (before: frictionless).
+MPM_REVISION = 2
 RUN_DEFAULTS = dict(field_frames=5, history_dt=0.01)
 
 
@@ -39,7 +43,7 @@ def run_hopper(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, ranks=
     base (output base path), wall [s], psteps, particles, mdr (half model) and mdr_full [kg/s/m],
     mfi, v_out, rho_out (outlet path means of the last 3 frames) and the scene keywords."""
     text = scene_text(**scene)
-    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
+    digest = hashlib.sha256(f"mpm revision {MPM_REVISION}\n{text}".encode()).hexdigest()[:12]
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     base = out / f"hopper_{label + '_' if label else ''}{digest}"
