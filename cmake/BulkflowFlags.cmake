@@ -42,8 +42,8 @@ endif()
 
 # Instruction set of optimised builds. The hot loops run over blocks of points (the VUMAT nblock
 # layout) and vectorise; AVX2 (x86-64-v3: every x86 server CPU since about 2015) holds four
-# doubles where baseline x86-64 holds two, measured +25-30 % CPE4R Mohr-Coulomb element-steps/s
-# (scripts/bench_solver.py prints both builds). Results do not change: -ffp-contract=off keeps
+# doubles where baseline x86-64 holds two: 1.2x CPE4R and 1.4x C3D8R Mohr-Coulomb element-steps/s
+# (scripts/bench_solver.py part 4 runs both builds). Results do not change: -ffp-contract=off keeps
 # FMA out and nothing reassociates, so an x86-64-v3 build and a baseline build agree bit for bit
 # (checked by the benchmark on its scenes). BULKFLOW_ARCH=auto takes x86-64-v3 when the compiler
 # accepts it and this machine runs it, else the compiler's default; give any -march value
