@@ -51,7 +51,8 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
                  fill_time=1.0, ramp=0.6, discharge_time=3.0, inflow=True, fill_damping=0.1,
                  flip=0.99, cfl=0.3, shape="GIMP", field_frames=10, history_dt=0.01,
                  dilation=True, title="", phi=20.0, psi_initial=15.0, eps_cv=0.2,
-                 psi_constant=None, young=1.0e7, poisson=0.2, density=1600.0, model="MC"):
+                 psi_constant=None, young=1.0e7, poisson=0.2, density=1600.0, model="MC",
+                 wall_reach=None):
     t = math.radians(theta)
     y0 = 0.5 * outlet / math.tan(t)          # outlet level
     ytop = y0 + height
@@ -114,7 +115,8 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
         w(f"{x:.9f}, {y:.9f}")
     w("*MPM WALL, NAME=AXIS, TYPE=SYMMETRY")
     w(f"0., {hi[1]:.9f}, 0., {lo[1]:.9f}")
-    w(f"*MPM WALL, NAME=WALL, FRICTION={mu:.7f}")
+    # REACH (docs/keywords.md): the inclined wall also acts on nodes up to REACH cells in front of it
+    w(f"*MPM WALL, NAME=WALL, FRICTION={mu:.7f}" + (f", REACH={wall_reach:g}" if wall_reach is not None else ""))
     w(f"{0.5 * outlet:.9f}, {y0:.9f}, {wall_top[0]:.9f}, {wall_top[1]:.9f}")
     w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu:.7f}")
     w(f"{lo[0]:.9f}, {y0:.9f}, {0.5 * outlet:.9f}, {y0:.9f}")
