@@ -1027,9 +1027,9 @@ contains
                  if (.not. wall_contains(w, nd, x, 0.0_dp)) cycle
                  b%x(p, :) = b%x(p, :) - d * n(1:nd)
                  ! The velocity into the wall goes, with the wall's own Coulomb law on what is
-                 ! left (wall_slide_velocity, as on the wall's nodes). A frictionless put-back
-                 ! let the particles along the inclined wall slide freely wherever many were put
-                 ! back (some cells: ~10x more), and those discharged ~40 % faster.
+                 ! left (wall_slide_velocity, as on the wall's nodes): a frictionless put-back
+                 ! let the particles put back slide along a rough wall (the ch. 4 hopper's
+                 ! discharge rates moved < 0.2 % with the friction, src/mpm/README.md).
                  b%v(p, :) = wall_slide_velocity(w, nd, b%v(p, :))
                  st%n_guarded = st%n_guarded + 1
               end do
