@@ -134,9 +134,17 @@ contains
     real(dp), intent(out) :: work
     logical, intent(out) :: touching
 
-    real(dp) :: xp(ndim), gap, normal(ndim), cp(ndim), tol, dvn, vrel(ndim), vt(ndim)
-    real(dp) :: vt_norm, dvt(ndim), gap2, normal2(ndim)
+    ! Work vectors of at most 3 components, used as their first ndim through the associate
+    ! names below: arrays sized by the dummy ndim are automatic arrays, which gfortran puts on
+    ! the heap (no -fstack-arrays), so this routine made about ten malloc/free pairs per slave
+    ! node per increment (a third of the contact phase).
+    real(dp) :: xp_buf(3), normal_buf(3), cp_buf(3), vrel_buf(3), vt_buf(3), dvt_buf(3)
+    real(dp) :: normal2_buf(3), xq_buf(3)
+    real(dp) :: gap, tol, dvn, vt_norm, gap2
 
+    associate (xp => xp_buf(1:ndim), normal => normal_buf(1:ndim), cp => cp_buf(1:ndim), &
+         vrel => vrel_buf(1:ndim), vt => vt_buf(1:ndim), dvt => dvt_buf(1:ndim), &
+         normal2 => normal2_buf(1:ndim), xq => xq_buf(1:ndim))
     dv = 0.0_dp
     work = 0.0_dp
     xp = xn + dt * vn
@@ -161,7 +169,8 @@ contains
        ! Written as a correction along the normal, not as (cp - x_n)/dt, so that the
        ! round-off of the closest point cannot move the node along the wall.
        ! Static friction does no work.
-       call surface_closest_point(wall, offset_new, xn + dt * wall_velocity, gap2, normal2, cp)
+       xq = xn + dt * wall_velocity
+       call surface_closest_point(wall, offset_new, xq, gap2, normal2, cp)
        dv = (wall_velocity - vn) - (gap2 / dt) * normal2
        return
     end if
@@ -189,11 +198,13 @@ contains
     ! adhesive (a node sliding with friction over a convex arc would otherwise be lifted
     ! off it a little every increment).
     if (mu > 0.0_dp) then
-       call surface_closest_point(wall, offset_new, xn + dt * (vn + dv), gap2, normal2, cp)
+       xq = xn + dt * (vn + dv)
+       call surface_closest_point(wall, offset_new, xq, gap2, normal2, cp)
        if (gap2 < -tol .or. (gap2 > tol .and. gap2 <= dvn * dt)) then
           dv = dv - (gap2 / dt) * normal2
        end if
     end if
+    end associate
   end subroutine node_contact
 
   !> Coulomb stick test |v_t| <= mu dv_n, written so that a rough wall (mu = huge) cannot

@@ -11,7 +11,7 @@ module driver_elements
   use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
        effect_bulk_viscosity, effect_user_field
   use driver_vumat_call, only: vumat_work_t, call_material, vumat_work_init
-  use fem_cpe4r, only: cpe4r_kinematics, cpe4r_internal_force, cpe4r_hourglass_update
+  use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_hourglass_update
   use fem_c3d8r, only: c3d8r_kinematics, c3d8r_internal_force, c3d8r_hourglass
   use fem_corotation, only: corotational_increment, deformation_gradient, to_global, vumat_defgrad, &
        vumat_stretch
@@ -30,10 +30,12 @@ module driver_elements
      real(dp), allocatable :: bmat_mid(:, :, :), bmat_new(:, :, :), fe(:, :, :), fe_hg(:, :, :)
      real(dp), allocatable :: volume_mid(:), volume_new(:), char_length(:), density(:), modulus(:)
      real(dp), allocatable :: volume_abs(:)           !< |volume_mid| (no temporary per call)
+     real(dp), allocatable :: gamma(:, :), bsq(:)     !< CPE4R: hourglass γ, Σ B² of B_{n+½}
      real(dp), allocatable :: e_hg_kernel(:)          !< the hourglass kernel's own ΔE (not booked)
      real(dp), allocatable :: wave_speed(:), sigma_bv(:), xi(:), e_bv(:), e_hg(:), dt_el(:)
      real(dp), allocatable :: strain_inc(:, :), spin_inc(:, :), strain_corot(:, :), rel_spin(:, :)
      real(dp), allocatable :: r_mid(:, :, :), r_new(:, :, :), f_old(:, :, :), f_new(:, :, :)
+     real(dp), allocatable :: rotation_swap(:, :, :)  !< unallocated: holder for the R exchange
      real(dp), allocatable :: stretch_old(:, :), stretch_new(:, :), defgrad_old(:, :), defgrad_new(:, :)
      real(dp), allocatable :: stress_force(:, :)
      integer, allocatable :: reason(:)
@@ -64,6 +66,7 @@ contains
     allocate(w%volume_mid(nmax), w%volume_new(nmax), w%char_length(nmax), w%density(nmax))
     allocate(w%modulus(nmax), w%wave_speed(nmax), w%sigma_bv(nmax), w%xi(nmax), w%e_bv(nmax))
     allocate(w%e_hg(nmax), w%dt_el(nmax), w%reason(nmax), w%volume_abs(nmax), w%e_hg_kernel(nmax))
+    allocate(w%gamma(nmax, nen), w%bsq(nmax))
     allocate(w%strain_inc(nmax, ncomp), w%spin_inc(nmax, nshr), w%strain_corot(nmax, ncomp))
     allocate(w%rel_spin(nmax, nshr), w%stress_force(nmax, ncomp))
     allocate(w%r_mid(nmax, ndim, ndim), w%r_new(nmax, ndim, ndim), w%f_old(nmax, ndim, ndim))
@@ -126,6 +129,7 @@ contains
     real(dp), intent(out) :: dt_min
     integer, intent(out) :: dt_elem
     integer :: ib, nb, e, nd, ne, iw
+    logical :: fe_written
 
     dt_min = huge(1.0_dp)
     dt_elem = 0
@@ -140,19 +144,19 @@ contains
          nb = blk%count
          if (nd == 2) then
             call gather_block_2d(nb, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
-                 solver%u, solver%du, w%xe_old, w%du, w%xe_mid, w%xe_new)
+                 solver%u, solver%du, w%xe_old, w%du)
          else
             call gather_block(nb, nd, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
                  solver%u, solver%du, w%xe_old, w%du, w%xe_mid, w%xe_new)
          end if
-         call block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
+         call block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2, fe_written)
          do e = 1, nb
             if (w%dt_el(e) < dt_min) then
                dt_min = w%dt_el(e)
                dt_elem = blk%elem_number(e)
             end if
          end do
-         solver%fe(blk%first:blk%first + nb - 1, :, :) = w%fe(1:nb, :, :)
+         if (.not. fe_written) solver%fe(blk%first:blk%first + nb - 1, :, :) = w%fe(1:nb, :, :)
        end associate
     end do
     call effects%stop(effect_elements)
@@ -186,12 +190,14 @@ contains
     end do
   end subroutine gather_block
 
-  !> gather_block for two components (CPE4R).
-  subroutine gather_block_2d(nb, ne, conn, x0, u, du_nodes, xe_old, du, xe_mid, xe_new)
+  !> gather_block for two components (CPE4R): x_n and du only. cpe4r_increment_kinematics forms
+  !> x_{n+½} and x_{n+1} from them in registers, with the expressions of gather_block (writing
+  !> and reading back two more (nb, 2, 4) arrays per block cost more than the additions).
+  subroutine gather_block_2d(nb, ne, conn, x0, u, du_nodes, xe_old, du)
     integer, intent(in) :: nb, ne
     integer, intent(in) :: conn(ne, nb)
     real(dp), intent(in) :: x0(2, *), u(2, *), du_nodes(2, *)
-    real(dp), intent(out) :: xe_old(nb, 2, ne), du(nb, 2, ne), xe_mid(nb, 2, ne), xe_new(nb, 2, ne)
+    real(dp), intent(out) :: xe_old(nb, 2, ne), du(nb, 2, ne)
     integer :: e, a, k
     real(dp) :: xo1, xo2, d1, d2
 
@@ -206,15 +212,13 @@ contains
           xe_old(e, 2, a) = xo2
           du(e, 1, a) = d1
           du(e, 2, a) = d2
-          xe_mid(e, 1, a) = xo1 + 0.5_dp * d1
-          xe_mid(e, 2, a) = xo2 + 0.5_dp * d2
-          xe_new(e, 1, a) = xo1 + d1
-          xe_new(e, 2, a) = xo2 + d2
        end do
     end do
   end subroutine gather_block_2d
 
-  subroutine block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
+  !> One block's increment. fe_written: the element forces are already in solver%fe (the
+  !> CPE4R hourglass kernel writes them there), else they are in w%fe.
+  subroutine block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2, fe_written)
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
     type(element_block_t), intent(inout) :: blk
@@ -222,6 +226,7 @@ contains
     type(element_work_t), intent(inout) :: w
     integer, intent(in) :: nb, nd, ne
     real(dp), intent(in) :: dt, b1, b2
+    logical, intent(out) :: fe_written
     integer :: e, nc, ns, a, i, hourglass_kind
     real(dp) :: hourglass_coefficient
     character(len=64) :: text
@@ -229,18 +234,21 @@ contains
 
     nc = solver%ncomp
     ns = solver%nshr
+    fe_written = .false.
     plane = m%mesh%element_type == element_cpe4r
     if (plane) then
-       call cpe4r_kinematics(nb, blk%thickness, w%xe_mid(1:nb, :, :), w%du(1:nb, :, :), &
-            w%xe_new(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), w%strain_inc(1:nb, :), &
-            w%spin_inc(1:nb, :), w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%char_length(1:nb))
+       ! Kinematics, inversion check, corotational step and density in one pass.
+       call cpe4r_increment_kinematics(nb, blk%thickness, w%xe_old, w%du, blk%bmat_ref, blk%volume_ref, &
+            default_min_volume_ratio, blk%mass, blk%rotation, w%volume_mid, w%volume_abs, w%density, &
+            w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, w%char_length, w%reason, &
+            w%r_mid, w%r_new, w%f_new, w%strain_corot, w%rel_spin)
     else
        call c3d8r_kinematics(nb, w%xe_mid(1:nb, :, :), w%du(1:nb, :, :), w%xe_new(1:nb, :, :), &
             w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), &
             w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%char_length(1:nb))
+       call check_inversion(nb, nd, ne, w%xe_new(1:nb, :, :), w%volume_new(1:nb), blk%volume_ref, &
+            default_min_volume_ratio, w%reason(1:nb))
     end if
-    call check_inversion(nb, nd, ne, w%xe_new(1:nb, :, :), w%volume_new(1:nb), blk%volume_ref, &
-         default_min_volume_ratio, w%reason(1:nb))
     if (any(w%reason(1:nb) /= 0)) then
        e = findloc(w%reason(1:nb) /= 0, .true., dim=1)
        ! The reason text is long: numbers go through a small buffer, the message is built by
@@ -251,9 +259,14 @@ contains
             ' (increment too large, mesh too coarse for the deformation, or material too soft)')
     end if
 
-    call corotational_increment(nb, nd, ne, blk%bmat_ref, w%xe_mid(1:nb, :, :), w%xe_new(1:nb, :, :), &
-         w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), blk%rotation, w%r_mid(1:nb, :, :), &
-         w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%strain_corot(1:nb, :), w%rel_spin(1:nb, :))
+    if (.not. plane) then
+       call corotational_increment(nb, nd, ne, blk%bmat_ref, w%xe_mid(1:nb, :, :), w%xe_new(1:nb, :, :), &
+            w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), blk%rotation, w%r_mid(1:nb, :, :), &
+            w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%strain_corot(1:nb, :), w%rel_spin(1:nb, :))
+       ! Current density at mid-increment, as Abaqus passes it (mass is conserved per element).
+       w%volume_abs(1:nb) = abs(w%volume_mid(1:nb))
+       w%density(1:nb) = blk%mass / w%volume_abs(1:nb)
+    end if
     if (blk%vumat_needs_kinematics) then
        call deformation_gradient(nb, nd, ne, blk%bmat_ref, w%xe_old(1:nb, :, :), w%f_old(1:nb, :, :))
        call vumat_defgrad(nb, nd, w%f_old(1:nb, :, :), w%defgrad_old(1:nb, :))
@@ -261,9 +274,6 @@ contains
        call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
        call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
     end if
-    ! Current density at mid-increment, as Abaqus passes it (mass is conserved per element).
-    w%volume_abs(1:nb) = abs(w%volume_mid(1:nb))
-    w%density(1:nb) = blk%mass / w%volume_abs(1:nb)
 
     ! PE (only when written): Δε^p = Δε − C⁻¹(σ_new − σ_old); the σ_old part before the call.
     if (size(blk%plastic_strain, 1) == nb) then
@@ -295,7 +305,11 @@ contains
          call add_elastic_compliance(nb, nc, props(1), props(2), -1.0_dp, blk%stress, blk%plastic_strain)
        end associate
     end if
-    blk%rotation = w%r_new(1:nb, :, :)
+    ! R_{n+1} becomes the block's rotation by exchanging the arrays (the work set has exactly nb
+    ! rows); the old R_n is overwritten by the next corotational step.
+    call move_alloc(blk%rotation, w%rotation_swap)
+    call move_alloc(w%r_new, blk%rotation)
+    call move_alloc(w%rotation_swap, w%r_new)
     call to_global(nb, nd, nc, blk%rotation, blk%stress, blk%stress_global)
 
     ! Mass scaling (driver_mass_scaling): wave speed, stable increment, bulk viscosity and
@@ -352,10 +366,12 @@ contains
        ! hourglass forces make; blk%force_hg keeps it for the next increment.
        if (plane) then
           ! One fused kernel: forces, force change and work in one pass over the block.
-          call cpe4r_hourglass_update(nb, blk%thickness, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), &
-               w%bmat_mid(1:nb, :, :), w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), &
-               hourglass_kind, hourglass_coefficient, w%r_mid(1:nb, :, :), blk%rotation, blk%hourglass, &
-               w%fe(1:nb, :, :), blk%force_hg, w%e_hg_kernel(1:nb), w%e_hg(1:nb))
+          ! The forces go straight into the solver's element array.
+          call cpe4r_hourglass_update(nb, blk%thickness, w%gamma, w%bsq, w%volume_mid, w%du, &
+               dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, blk%rotation, &
+               blk%hourglass, w%fe, size(solver%fe, 1), blk%first, solver%fe, blk%force_hg, &
+               w%e_hg_kernel, w%e_hg)
+          fe_written = .true.
        else
           w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)
           call c3d8r_hourglass(nb, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), &

@@ -201,8 +201,7 @@ contains
 
       ! Velocities at mid-increment (the first increment of the run starts from v_0 with dt/2).
       dt_avg = merge(0.5_dp * dt, 0.5_dp * (solver%dt_prev + dt), solver%increment == 0)
-      call update_velocities(solver%n_nodes * solver%ndim, dt_avg, solver%a, solver%v, solver%v_old, &
-           solver%v_free)
+      call update_velocities(solver%n_nodes * solver%ndim, dt_avg, solver%a, solver%v, solver%v_old)
 
       if (effects%active(effect_boundary)) then
          call effects%start(effect_boundary)
@@ -291,11 +290,11 @@ contains
     if (solver%ndim == 2) then
        ! A literal component count: the compiler keeps the per-node sums in registers.
        call constraint_work_nodes(2, solver%n_nodes, solver%part%node_owned, solver%mass, solver%a, &
-            solver%reaction, solver%v, solver%v_free, solver%v_old, solver%dt_prev, dt, dt_avg, &
+            solver%reaction, solver%v, solver%v_old, solver%dt_prev, dt, dt_avg, &
             solver%du, work)
     else
        call constraint_work_nodes(solver%ndim, solver%n_nodes, solver%part%node_owned, solver%mass, &
-            solver%a, solver%reaction, solver%v, solver%v_free, solver%v_old, solver%dt_prev, dt, &
+            solver%a, solver%reaction, solver%v, solver%v_old, solver%dt_prev, dt, &
             dt_avg, solver%du, work)
     end if
     solver%e_external = solver%e_external + work + friction_work
@@ -303,17 +302,19 @@ contains
 
   !> The node loop of constraint_work: work += Σ over owned nodes with mass, in node order; the
   !> per-node sums over the components run from 0 in component order (as sum() did), so the
-  !> result is the same to the bit. du = dt v on every node.
-  pure subroutine constraint_work_nodes(nd, nn, owned, mass, a, reaction, v, v_free, v_old, &
+  !> result is the same to the bit. du = dt v on every node. The unconstrained velocity
+  !> v_free = v_old + Δt_avg a is formed here with update_velocities' expression (the same value
+  !> to the bit), instead of being stored by it and read back: one nodal array less to stream.
+  pure subroutine constraint_work_nodes(nd, nn, owned, mass, a, reaction, v, v_old, &
        dt_prev, dt, dt_avg, du, work)
     integer, intent(in) :: nd, nn
     logical, intent(in) :: owned(nn)
-    real(dp), intent(in) :: mass(nn), a(nd, nn), reaction(nd, nn), v(nd, nn), v_free(nd, nn)
+    real(dp), intent(in) :: mass(nn), a(nd, nn), reaction(nd, nn), v(nd, nn)
     real(dp), intent(in) :: v_old(nd, nn), dt_prev, dt, dt_avg
     real(dp), intent(out) :: du(nd, nn)
     real(dp), intent(inout) :: work
     integer :: i, j
-    real(dp) :: ddt, aj, impulse, s_v, s_a2, s_ai
+    real(dp) :: ddt, aj, impulse, s_v, s_a2, s_ai, v_free
 
     ddt = 0.25_dp * (dt_prev - dt)
     do i = 1, nn
@@ -326,7 +327,8 @@ contains
        s_ai = 0
        do j = 1, nd
           aj = a(j, i) - reaction(j, i) / mass(i)
-          impulse = mass(i) * (v(j, i) - v_free(j, i)) + dt_avg * reaction(j, i)
+          v_free = v_old(j, i) + dt_avg * a(j, i)
+          impulse = mass(i) * (v(j, i) - v_free) + dt_avg * reaction(j, i)
           s_v = s_v + impulse * (v_old(j, i) + v(j, i))
           s_a2 = s_a2 + aj**2
           s_ai = s_ai + aj * impulse
@@ -335,13 +337,12 @@ contains
     end do
   end subroutine constraint_work_nodes
 
-  !> v_{n-1/2} kept, v_{n+1/2} = v_{n-1/2} + Δt_avg a_n, and the unconstrained copy v_free, in one
-  !> pass (n = ndim × nodes values).
-  pure subroutine update_velocities(n, dt_avg, a, v, v_old, v_free)
+  !> v_{n-1/2} kept, v_{n+1/2} = v_{n-1/2} + Δt_avg a_n, in one pass (n = ndim × nodes values).
+  pure subroutine update_velocities(n, dt_avg, a, v, v_old)
     integer, intent(in) :: n
     real(dp), intent(in) :: dt_avg, a(n)
     real(dp), intent(inout) :: v(n)
-    real(dp), intent(out) :: v_old(n), v_free(n)
+    real(dp), intent(out) :: v_old(n)
     integer :: k
     real(dp) :: vk
 
@@ -350,7 +351,6 @@ contains
        v_old(k) = vk
        vk = vk + dt_avg * a(k)
        v(k) = vk
-       v_free(k) = vk
     end do
   end subroutine update_velocities
 

@@ -64,9 +64,10 @@ module driver_solver
      real(dp), allocatable :: f_int(:, :), f_ext(:, :), f_contact(:, :), reaction(:, :)
      logical, allocatable :: fixed(:, :)              !< (ndim, n_nodes) dof prescribed this step
      real(dp), allocatable :: du(:, :), f_ext_old(:, :)  !< increment work arrays
-     !> v_{n-1/2} and the unconstrained v_{n+1/2} = v_{n-1/2} + Δt_avg a_n of the increment: the
-     !> constraint impulses (supports, walls) are m (v − v_free) and their work uses both.
-     real(dp), allocatable :: v_old(:, :), v_free(:, :)
+     !> v_{n-1/2} of the increment: the constraint impulses (supports, walls) are m (v − v_free),
+     !> v_free = v_{n-1/2} + Δt_avg a_n the unconstrained v_{n+1/2}, and their work uses both
+     !> (constraint_work forms v_free again from v_old and a: no array of its own).
+     real(dp), allocatable :: v_old(:, :)
      real(dp), allocatable :: fe(:, :, :)             !< (n_local_elems, ndim, nen) element forces
      integer :: n_blocks = 0
      type(element_block_t), allocatable :: blocks(:)

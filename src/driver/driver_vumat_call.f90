@@ -71,7 +71,8 @@ contains
     ! of a run).
     real(dp), allocatable, intent(inout) :: stress(:, :), state(:, :)
     real(dp), intent(inout) :: field(:, :)
-    real(dp), intent(inout) :: e_int(nb), e_inel(nb)
+    ! Allocatable for the same reason as stress and state.
+    real(dp), allocatable, intent(inout) :: e_int(:), e_inel(:)
     type(vumat_work_t), intent(inout) :: w
     integer :: nstatev, nfieldv, nprops, ns, nf
 
@@ -100,12 +101,13 @@ contains
             w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
     else
        ! Without a user field stateOld is the block's state itself (a contiguous (nb, ns) array,
-       ! read only by the VUMAT): no copy through state_mid.
-       w%field_new(1:nb, 1:nf) = field(1:nb, 1:nf)
+       ! read only by the VUMAT): no copy through state_mid. The fields do not change, so the
+       ! block's array is fieldOld and fieldNew at once (both read-only for a VUMAT); before, it
+       ! was copied to the work array and back every call.
        call vumat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
             mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
             w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, state(1:nb, 1:ns), &
-            e_int, e_inel, w%temp(1:nb), stretch_new, defgrad_new, w%field_new(1:nb, 1:nf), &
+            e_int, e_inel, w%temp(1:nb), stretch_new, defgrad_new, field(1:nb, 1:nf), &
             w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
     end if
     ! The new stress and state become the block's by swapping allocations when the shapes agree
@@ -113,10 +115,25 @@ contains
     ! counts); the old arrays become the work arrays the next VUMAT call overwrites.
     call swap_or_copy(stress, w%stress_new, nb, ncomp)
     call swap_or_copy(state, w%state_new, nb, ns)
-    field(1:nb, 1:nf) = w%field_new(1:nb, 1:nf)
-    e_int = w%e_int_new(1:nb)
-    e_inel = w%e_inel_new(1:nb)
+    if (mat%user_field) field(1:nb, 1:nf) = w%field_new(1:nb, 1:nf)
+    call swap_or_copy_1d(e_int, w%e_int_new, nb)
+    call swap_or_copy_1d(e_inel, w%e_inel_new, nb)
   end subroutine call_material
+
+  !> swap_or_copy for the (nb) energy arrays.
+  subroutine swap_or_copy_1d(block, work, nb)
+    real(dp), allocatable, intent(inout) :: block(:), work(:)
+    integer, intent(in) :: nb
+    real(dp), allocatable :: held(:)
+
+    if (size(block) == nb .and. size(work) == nb) then
+       call move_alloc(block, held)
+       call move_alloc(work, block)
+       call move_alloc(held, work)
+    else
+       block(1:nb) = work(1:nb)
+    end if
+  end subroutine swap_or_copy_1d
 
   !> block(1:nb, 1:nc) ← work(1:nb, 1:nc): by exchanging the allocations when both have exactly
   !> that shape, else by copying.

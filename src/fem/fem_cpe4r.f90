@@ -15,11 +15,13 @@
 module fem_cpe4r
   use material_kinds, only: dp
   use fem_hourglass, only: hourglass_viscous, hourglass_stiffness
+  use fem_inversion, only: inversion_none, inversion_centre, inversion_corner, inversion_collapse
   implicit none
   private
 
   public :: cpe4r_geometry, cpe4r_char_length, cpe4r_strain_increment, cpe4r_kinematics
   public :: cpe4r_internal_force, cpe4r_hourglass_gamma, cpe4r_hourglass, cpe4r_hourglass_update
+  public :: cpe4r_increment_kinematics
 
   integer, parameter, public :: cpe4r_ndim = 2, cpe4r_nen = 4, cpe4r_ncomp = 4
   integer, parameter, public :: cpe4r_nshr = 1, cpe4r_nmode = 1
@@ -198,6 +200,210 @@ contains
     end do
   end subroutine cpe4r_kinematics
 
+  !> The solver's whole pre-material pass of a CPE4R block in one element loop: the work of
+  !> cpe4r_kinematics, fem_inversion's check_inversion (2D), fem_corotation's
+  !> corotational_increment (2D), the current density and the hourglass shape vector γ.
+  !> Why one loop: each of those passes streamed the block's coordinates, B matrices and
+  !> rotations through the cache again (the block's (nb, 2, 4) arrays do not fit in L1), and
+  !> the gather wrote x_{n+½} and x_{n+1} only for them to read back; here they are formed in
+  !> registers from x_n and du with the gather's expressions. Every quantity is the same
+  !> expression, in the same order, as in those routines, so the results are the same to the bit.
+  !> xe_old = x_n, du = Δt v_{n+½} (the gather); x_{n+½} = x_n + ½du, x_{n+1} = x_n + du.
+  !> bmat_ref, volume_ref: reference mean gradient and volume; mass: element masses; r_old = R_n.
+  !> Out: as cpe4r_kinematics (volume_mid, strain_inc, volume_new, bmat_new, char_length),
+  !> volume_abs = |volume_mid|, density = mass/|volume_mid|, reason (fem_inversion codes,
+  !> check_inversion's order of tests), as corotational_increment r_mid, r_new, f_new,
+  !> strain_inc_corot, rel_spin, and for cpe4r_hourglass_update, in place of B_{n+½}: gamma
+  !> (nb, 4), γ of x_{n+½} (cpe4r_hourglass_gamma), and bsq = Σ_iI B_iI² of B_{n+½} (the
+  !> stiffness form's scale, summed in its order).
+  pure subroutine cpe4r_increment_kinematics(nb, thickness, xe_old, du, bmat_ref, volume_ref, &
+       min_volume_ratio, mass, r_old, volume_mid, volume_abs, density, gamma, bsq, &
+       strain_inc, volume_new, bmat_new, char_length, reason, r_mid, r_new, f_new, &
+       strain_inc_corot, rel_spin)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: thickness(nb), xe_old(nb, 2, 4), du(nb, 2, 4), bmat_ref(nb, 2, 4)
+    real(dp), intent(in) :: volume_ref(nb), min_volume_ratio, mass(nb), r_old(nb, 2, 2)
+    real(dp), intent(out) :: volume_mid(nb), volume_abs(nb), density(nb), gamma(nb, 4), bsq(nb)
+    real(dp), intent(out) :: strain_inc(nb, 4), volume_new(nb), bmat_new(nb, 2, 4)
+    real(dp), intent(out) :: char_length(nb)
+    integer, intent(out) :: reason(nb)
+    real(dp), intent(out) :: r_mid(nb, 2, 2), r_new(nb, 2, 2), f_new(nb, 2, 2)
+    real(dp), intent(out) :: strain_inc_corot(nb, 4), rel_spin(nb, 1)
+    ! x_{n+½} (m) and x_{n+1} (n) of the four nodes
+    real(dp) :: mx1, mx2, mx3, mx4, my1, my2, my3, my4, nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4
+    real(dp) :: dx, dy, ex, ey, area, r2a, l2max, vol, jmin, hx, hy
+    real(dp) :: b11, b12, b13, b14, b21, b22, b23, b24, l11, l12, l21, l22, spin
+    real(dp) :: x2, x3, x4, y2, y3, y4, f11, f21, f12, f22, c, s, nrm
+    real(dp) :: q11, q12, q21, q22, a11, a22, a12, t11, t12, t21, t22, u12, u21
+    real(dp) :: n11, n12, n21, n22, d11, d22, d12, d21
+    integer :: e, r
+
+    ! ivdep: the dummies do not alias (Fortran); the compiler's run-time alias checks for this
+    ! many arrays exceed its limit and it would leave the loop scalar.
+    !GCC$ ivdep
+    do e = 1, nb
+       ! the gather's x_{n+½} = x_n + ½ du and x_{n+1} = x_n + du
+       mx1 = xe_old(e, 1, 1) + 0.5_dp * du(e, 1, 1)
+       mx2 = xe_old(e, 1, 2) + 0.5_dp * du(e, 1, 2)
+       mx3 = xe_old(e, 1, 3) + 0.5_dp * du(e, 1, 3)
+       mx4 = xe_old(e, 1, 4) + 0.5_dp * du(e, 1, 4)
+       my1 = xe_old(e, 2, 1) + 0.5_dp * du(e, 2, 1)
+       my2 = xe_old(e, 2, 2) + 0.5_dp * du(e, 2, 2)
+       my3 = xe_old(e, 2, 3) + 0.5_dp * du(e, 2, 3)
+       my4 = xe_old(e, 2, 4) + 0.5_dp * du(e, 2, 4)
+       nx1 = xe_old(e, 1, 1) + du(e, 1, 1)
+       nx2 = xe_old(e, 1, 2) + du(e, 1, 2)
+       nx3 = xe_old(e, 1, 3) + du(e, 1, 3)
+       nx4 = xe_old(e, 1, 4) + du(e, 1, 4)
+       ny1 = xe_old(e, 2, 1) + du(e, 2, 1)
+       ny2 = xe_old(e, 2, 2) + du(e, 2, 2)
+       ny3 = xe_old(e, 2, 3) + du(e, 2, 3)
+       ny4 = xe_old(e, 2, 4) + du(e, 2, 4)
+
+       ! x_{n+½}: volume and B (cpe4r_geometry), density, γ and Σ B² (cpe4r_hourglass_gamma,
+       ! cpe4r_hourglass_update)
+       dx = mx3 - mx1
+       dy = my3 - my1
+       ex = mx4 - mx2
+       ey = my4 - my2
+       area = 0.5_dp * (dx * ey - dy * ex)
+       vol = thickness(e) * area
+       volume_mid(e) = vol
+       volume_abs(e) = abs(vol)
+       density(e) = mass(e) / abs(vol)
+       hx = mx1 - mx2 + mx3 - mx4
+       hy = my1 - my2 + my3 - my4
+       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
+       b11 = -ey * r2a
+       b12 = dy * r2a
+       b13 = ey * r2a
+       b14 = -dy * r2a
+       b21 = ex * r2a
+       b22 = -dx * r2a
+       b23 = -ex * r2a
+       b24 = dx * r2a
+       gamma(e, 1) = hg_base(1) - hx * b11 - hy * b21
+       gamma(e, 2) = hg_base(2) - hx * b12 - hy * b22
+       gamma(e, 3) = hg_base(3) - hx * b13 - hy * b23
+       gamma(e, 4) = hg_base(4) - hx * b14 - hy * b24
+       bsq(e) = ((((((((0.0_dp + b11**2) + b21**2) + b12**2) + b22**2) + b13**2) + b23**2) &
+            + b14**2) + b24**2)
+       ! strain and spin increments (cpe4r_strain_increment)
+       l11 = (((0.0_dp + du(e, 1, 1) * b11) + du(e, 1, 2) * b12) + du(e, 1, 3) * b13) + du(e, 1, 4) * b14
+       l12 = (((0.0_dp + du(e, 1, 1) * b21) + du(e, 1, 2) * b22) + du(e, 1, 3) * b23) + du(e, 1, 4) * b24
+       l21 = (((0.0_dp + du(e, 2, 1) * b11) + du(e, 2, 2) * b12) + du(e, 2, 3) * b13) + du(e, 2, 4) * b14
+       l22 = (((0.0_dp + du(e, 2, 1) * b21) + du(e, 2, 2) * b22) + du(e, 2, 3) * b23) + du(e, 2, 4) * b24
+       strain_inc(e, 1) = l11
+       strain_inc(e, 2) = l22
+       strain_inc(e, 3) = 0.0_dp
+       strain_inc(e, 4) = 0.5_dp * (l12 + l21)
+       spin = 0.5_dp * (l21 - l12)
+
+       ! x_{n+1}: volume and B (cpe4r_geometry), L_e (cpe4r_char_length)
+       dx = nx3 - nx1
+       dy = ny3 - ny1
+       ex = nx4 - nx2
+       ey = ny4 - ny2
+       area = 0.5_dp * (dx * ey - dy * ex)
+       vol = thickness(e) * area
+       volume_new(e) = vol
+       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
+       bmat_new(e, 1, 1) = -ey * r2a
+       bmat_new(e, 1, 2) = dy * r2a
+       bmat_new(e, 1, 3) = ey * r2a
+       bmat_new(e, 1, 4) = -dy * r2a
+       bmat_new(e, 2, 1) = ex * r2a
+       bmat_new(e, 2, 2) = -dx * r2a
+       bmat_new(e, 2, 3) = -ex * r2a
+       bmat_new(e, 2, 4) = dx * r2a
+       l2max = max((nx2 - nx1)**2 + (ny2 - ny1)**2, (nx3 - nx2)**2 + (ny3 - ny2)**2, &
+                   (nx4 - nx3)**2 + (ny4 - ny3)**2, (nx1 - nx4)**2 + (ny1 - ny4)**2)
+       char_length(e) = abs(area) / sqrt(max(l2max, tiny(1.0_dp)))
+
+       ! check_inversion_2d on x_{n+1}: corner values ξ_I η_I (x_nξ − x_I) × (x_nη − x_I) in
+       ! node order (neighbours 2,4 / 1,3 / 4,2 / 3,1; sign +, −, +, −), their running minimum
+       jmin = huge(1.0_dp)
+       jmin = min(jmin, 1.0_dp * ((nx2 - nx1) * (ny4 - ny1) - (ny2 - ny1) * (nx4 - nx1)))
+       jmin = min(jmin, -1.0_dp * ((nx1 - nx2) * (ny3 - ny2) - (ny1 - ny2) * (nx3 - nx2)))
+       jmin = min(jmin, 1.0_dp * ((nx4 - nx3) * (ny2 - ny3) - (ny4 - ny3) * (nx2 - nx3)))
+       jmin = min(jmin, -1.0_dp * ((nx3 - nx4) * (ny1 - ny4) - (ny3 - ny4) * (nx1 - nx4)))
+       r = inversion_none
+       if (vol < min_volume_ratio * volume_ref(e)) r = inversion_collapse
+       if (jmin <= 0.0_dp) r = inversion_corner
+       if (vol <= 0.0_dp) r = inversion_centre
+       reason(e) = r
+
+       ! corotational_increment_2d: F_{n+½} and R_{n+½}
+       x2 = mx2 - mx1
+       x3 = mx3 - mx1
+       x4 = mx4 - mx1
+       y2 = my2 - my1
+       y3 = my3 - my1
+       y4 = my4 - my1
+       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
+       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
+       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
+       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       c = f11 + f22
+       s = f21 - f12
+       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
+       q11 = c / nrm
+       q21 = s / nrm
+       q12 = -s / nrm
+       q22 = c / nrm
+       r_mid(e, 1, 1) = q11
+       r_mid(e, 2, 1) = q21
+       r_mid(e, 1, 2) = q12
+       r_mid(e, 2, 2) = q22
+       ! F_{n+1} and R_{n+1}
+       x2 = nx2 - nx1
+       x3 = nx3 - nx1
+       x4 = nx4 - nx1
+       y2 = ny2 - ny1
+       y3 = ny3 - ny1
+       y4 = ny4 - ny1
+       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
+       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
+       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
+       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       f_new(e, 1, 1) = f11
+       f_new(e, 2, 1) = f21
+       f_new(e, 1, 2) = f12
+       f_new(e, 2, 2) = f22
+       c = f11 + f22
+       s = f21 - f12
+       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
+       n11 = c / nrm
+       n21 = s / nrm
+       n12 = -s / nrm
+       n22 = c / nrm
+       r_new(e, 1, 1) = n11
+       r_new(e, 2, 1) = n21
+       r_new(e, 1, 2) = n12
+       r_new(e, 2, 2) = n22
+       ! strainInc = R_{n+½}ᵀ Δε R_{n+½}
+       a11 = l11
+       a22 = l22
+       a12 = 0.5_dp * (l12 + l21)
+       t11 = (0.0_dp + a11 * q11) + a12 * q21
+       t12 = (0.0_dp + a11 * q12) + a12 * q22
+       t21 = (0.0_dp + a12 * q11) + a22 * q21
+       t22 = (0.0_dp + a12 * q12) + a22 * q22
+       strain_inc_corot(e, 1) = (0.0_dp + q11 * t11) + q21 * t21
+       strain_inc_corot(e, 2) = (0.0_dp + q12 * t12) + q22 * t22
+       strain_inc_corot(e, 3) = 0.0_dp
+       u12 = (0.0_dp + q11 * t12) + q21 * t22
+       u21 = (0.0_dp + q12 * t11) + q22 * t21
+       strain_inc_corot(e, 4) = 0.5_dp * (u12 + u21)
+       ! relSpinInc: ΔR = R_{n+1} R_nᵀ
+       d11 = (0.0_dp + n11 * r_old(e, 1, 1)) + n12 * r_old(e, 1, 2)
+       d22 = (0.0_dp + n21 * r_old(e, 2, 1)) + n22 * r_old(e, 2, 2)
+       d12 = (0.0_dp + n11 * r_old(e, 2, 1)) + n12 * r_old(e, 2, 2)
+       d21 = (0.0_dp + n21 * r_old(e, 1, 1)) + n22 * r_old(e, 1, 2)
+       rel_spin(e, 1) = spin - 2.0_dp * (d21 - d12) / (2.0_dp + d11 + d22)
+    end do
+  end subroutine cpe4r_increment_kinematics
+
   !> f_iI = V Σ_j σ_ij B_jI with the global stress (σ33 does no work in plane strain).
   !> Overwrites fe; hourglass and bulk-viscosity routines add to it.
   pure subroutine cpe4r_internal_force(nb, volume, bmat, stress, fe)
@@ -258,40 +464,60 @@ contains
     real(dp), intent(inout) :: hg_state(nb, 2, 1)
     real(dp), intent(inout) :: fe(nb, 2, 4)
     real(dp), intent(out) :: energy_inc(nb)
-    real(dp), allocatable :: force_hg(:, :, :), work(:)
+    real(dp), allocatable :: force_hg(:, :, :), work(:), gamma(:, :, :), bsq(:), fe_in(:, :, :)
+    integer :: n, i
 
     ! Not on the solver's path (tests, single elements): the extra arrays may be allocated.
-    allocate(force_hg(nb, 2, 4), work(nb))
+    allocate(force_hg(nb, 2, 4), work(nb), gamma(nb, 4, 1), bsq(nb), fe_in(nb, 2, 4))
     force_hg = 0.0_dp
-    call cpe4r_hourglass_update(nb, thickness, xe_mid, volume_mid, bmat_mid, du, dt, density, &
-         modulus, kind, coefficient, rot_mid, rot_new, hg_state, fe, force_hg, energy_inc, work)
+    ! γ and Σ B² as cpe4r_increment_kinematics forms them
+    call cpe4r_hourglass_gamma(nb, xe_mid, bmat_mid, gamma)
+    bsq = 0.0_dp
+    do n = 1, 4
+       do i = 1, 2
+          bsq = bsq + bmat_mid(:, i, n)**2
+       end do
+    end do
+    fe_in = fe
+    call cpe4r_hourglass_update(nb, thickness, gamma(:, :, 1), bsq, volume_mid, du, dt, density, &
+         modulus, kind, coefficient, rot_mid, rot_new, hg_state, fe_in, nb, 1, fe, force_hg, &
+         energy_inc, work)
   end subroutine cpe4r_hourglass
 
   !> cpe4r_hourglass as the solver uses it: one element loop on scalars (no block temporaries,
   !> every element read once), which also books the hourglass work.
+  !> gamma (nb, 4): γ of x_{n+½}; bsq (nb): Σ_iI B_iI² of B_{n+½} (read by the stiffness form
+  !> only); both from cpe4r_increment_kinematics, in place of x_{n+½} and B_{n+½}.
+  !> fe_in (nb, 2, 4): the block's forces without hourglass; fe_out: the solver's element force
+  !> array of n_out elements, whose elements first .. first+nb−1 receive fe_in + the hourglass
+  !> forces. (Written there directly: the driver's copy of the block's forces into the solver's
+  !> array was a pass of its own.)
   !> force_hg (nb, 2, 4): in, the hourglass forces of the element at t_n; out, those at t_{n+1},
   !> taken as the change of fe they make (fe_after − fe_before: the forces the assembly sees).
   !> work (nb): ½ Σ_iI (f_n + f_{n+1})_iI du_iI, the trapezoidal work of the hourglass forces
   !> over the increment, as the energy balance charges it (ALLAE).
   !> The sums and their order are those of cpe4r_hourglass_gamma, fem_hourglass's
   !> hourglass_forces and the driver's former separate work loop, so results are bitwise the same.
-  pure subroutine cpe4r_hourglass_update(nb, thickness, xe_mid, volume_mid, bmat_mid, du, dt, &
-                                         density, modulus, kind, coefficient, rot_mid, rot_new, &
-                                         hg_state, fe, force_hg, energy_inc, work)
+  pure subroutine cpe4r_hourglass_update(nb, thickness, gamma, bsq, volume_mid, du, dt, density, &
+                                         modulus, kind, coefficient, rot_mid, rot_new, hg_state, &
+                                         fe_in, n_out, first, fe_out, force_hg, energy_inc, work)
     integer, intent(in) :: nb
     real(dp), intent(in) :: thickness(nb)
-    real(dp), intent(in) :: xe_mid(nb, 2, 4), volume_mid(nb), bmat_mid(nb, 2, 4)
+    real(dp), intent(in) :: gamma(nb, 4), bsq(nb), volume_mid(nb)
     real(dp), intent(in) :: du(nb, 2, 4), dt
     real(dp), intent(in) :: density(nb), modulus(nb)
     integer, intent(in) :: kind
     real(dp), intent(in) :: coefficient
     real(dp), intent(in) :: rot_mid(nb, 2, 2), rot_new(nb, 2, 2)
     real(dp), intent(inout) :: hg_state(nb, 2, 1)
-    real(dp), intent(inout) :: fe(nb, 2, 4), force_hg(nb, 2, 4)
+    real(dp), intent(in) :: fe_in(nb, 2, 4)
+    integer, intent(in) :: n_out, first
+    real(dp), intent(inout) :: fe_out(n_out, 2, 4)
+    real(dp), intent(inout) :: force_hg(nb, 2, 4)
     real(dp), intent(out) :: energy_inc(nb), work(nb)
-    real(dp) :: hx, hy, g1, g2, g3, g4, q1, q2, qc1, qc2, h1, h2, qg1, qg2, area, scale, c, dtm
+    real(dp) :: g1, g2, g3, g4, q1, q2, qc1, qc2, h1, h2, qg1, qg2, area, scale, c, dtm
     real(dp) :: f_old, f_new, df, w
-    integer :: e
+    integer :: e, o
 
     dtm = max(dt, tiny(1.0_dp))
     if (kind == hourglass_viscous) then
@@ -300,13 +526,12 @@ contains
        ! this many arrays exceed its limit, and it then left the loop scalar.)
        !GCC$ ivdep
        do e = 1, nb
+          o = first + e - 1
           ! γ_I = h_I − (h·x) B_xI − (h·y) B_yI (cpe4r_hourglass_gamma)
-          hx = xe_mid(e, 1, 1) - xe_mid(e, 1, 2) + xe_mid(e, 1, 3) - xe_mid(e, 1, 4)
-          hy = xe_mid(e, 2, 1) - xe_mid(e, 2, 2) + xe_mid(e, 2, 3) - xe_mid(e, 2, 4)
-          g1 = hg_base(1) - hx * bmat_mid(e, 1, 1) - hy * bmat_mid(e, 2, 1)
-          g2 = hg_base(2) - hx * bmat_mid(e, 1, 2) - hy * bmat_mid(e, 2, 2)
-          g3 = hg_base(3) - hx * bmat_mid(e, 1, 3) - hy * bmat_mid(e, 2, 3)
-          g4 = hg_base(4) - hx * bmat_mid(e, 1, 4) - hy * bmat_mid(e, 2, 4)
+          g1 = gamma(e, 1)
+          g2 = gamma(e, 2)
+          g3 = gamma(e, 3)
+          g4 = gamma(e, 4)
           ! q_i = Σ_I γ_I du_iI
           q1 = (((0.0_dp + g1 * du(e, 1, 1)) + g2 * du(e, 1, 2)) + g3 * du(e, 1, 3)) + g4 * du(e, 1, 4)
           q2 = (((0.0_dp + g1 * du(e, 2, 1)) + g2 * du(e, 2, 2)) + g3 * du(e, 2, 3)) + g4 * du(e, 2, 4)
@@ -319,21 +544,21 @@ contains
           energy_inc(e) = (0.0_dp + qg1 * q1) + qg2 * q2
           ! f_iI += qg_i γ_I; the force change and its trapezoidal work, node by node, i inner
           w = 0.0_dp
-          f_old = fe(e, 1, 1); f_new = f_old + qg1 * g1; fe(e, 1, 1) = f_new; df = f_new - f_old
+          f_old = fe_in(e, 1, 1); f_new = f_old + qg1 * g1; fe_out(o, 1, 1) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 1, 1) + df) * du(e, 1, 1); force_hg(e, 1, 1) = df
-          f_old = fe(e, 2, 1); f_new = f_old + qg2 * g1; fe(e, 2, 1) = f_new; df = f_new - f_old
+          f_old = fe_in(e, 2, 1); f_new = f_old + qg2 * g1; fe_out(o, 2, 1) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 2, 1) + df) * du(e, 2, 1); force_hg(e, 2, 1) = df
-          f_old = fe(e, 1, 2); f_new = f_old + qg1 * g2; fe(e, 1, 2) = f_new; df = f_new - f_old
+          f_old = fe_in(e, 1, 2); f_new = f_old + qg1 * g2; fe_out(o, 1, 2) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 1, 2) + df) * du(e, 1, 2); force_hg(e, 1, 2) = df
-          f_old = fe(e, 2, 2); f_new = f_old + qg2 * g2; fe(e, 2, 2) = f_new; df = f_new - f_old
+          f_old = fe_in(e, 2, 2); f_new = f_old + qg2 * g2; fe_out(o, 2, 2) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 2, 2) + df) * du(e, 2, 2); force_hg(e, 2, 2) = df
-          f_old = fe(e, 1, 3); f_new = f_old + qg1 * g3; fe(e, 1, 3) = f_new; df = f_new - f_old
+          f_old = fe_in(e, 1, 3); f_new = f_old + qg1 * g3; fe_out(o, 1, 3) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 1, 3) + df) * du(e, 1, 3); force_hg(e, 1, 3) = df
-          f_old = fe(e, 2, 3); f_new = f_old + qg2 * g3; fe(e, 2, 3) = f_new; df = f_new - f_old
+          f_old = fe_in(e, 2, 3); f_new = f_old + qg2 * g3; fe_out(o, 2, 3) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 2, 3) + df) * du(e, 2, 3); force_hg(e, 2, 3) = df
-          f_old = fe(e, 1, 4); f_new = f_old + qg1 * g4; fe(e, 1, 4) = f_new; df = f_new - f_old
+          f_old = fe_in(e, 1, 4); f_new = f_old + qg1 * g4; fe_out(o, 1, 4) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 1, 4) + df) * du(e, 1, 4); force_hg(e, 1, 4) = df
-          f_old = fe(e, 2, 4); f_new = f_old + qg2 * g4; fe(e, 2, 4) = f_new; df = f_new - f_old
+          f_old = fe_in(e, 2, 4); f_new = f_old + qg2 * g4; fe_out(o, 2, 4) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 2, 4) + df) * du(e, 2, 4); force_hg(e, 2, 4) = df
           work(e) = w
        end do
@@ -342,20 +567,16 @@ contains
 
     ! Stiffness form, or none: the same steps with the generalised force of that form.
     do e = 1, nb
-       hx = xe_mid(e, 1, 1) - xe_mid(e, 1, 2) + xe_mid(e, 1, 3) - xe_mid(e, 1, 4)
-       hy = xe_mid(e, 2, 1) - xe_mid(e, 2, 2) + xe_mid(e, 2, 3) - xe_mid(e, 2, 4)
-       g1 = hg_base(1) - hx * bmat_mid(e, 1, 1) - hy * bmat_mid(e, 2, 1)
-       g2 = hg_base(2) - hx * bmat_mid(e, 1, 2) - hy * bmat_mid(e, 2, 2)
-       g3 = hg_base(3) - hx * bmat_mid(e, 1, 3) - hy * bmat_mid(e, 2, 3)
-       g4 = hg_base(4) - hx * bmat_mid(e, 1, 4) - hy * bmat_mid(e, 2, 4)
+       o = first + e - 1
+       g1 = gamma(e, 1)
+       g2 = gamma(e, 2)
+       g3 = gamma(e, 3)
+       g4 = gamma(e, 4)
        q1 = (((0.0_dp + g1 * du(e, 1, 1)) + g2 * du(e, 1, 2)) + g3 * du(e, 1, 3)) + g4 * du(e, 1, 4)
        q2 = (((0.0_dp + g1 * du(e, 2, 1)) + g2 * du(e, 2, 2)) + g3 * du(e, 2, 3)) + g4 * du(e, 2, 4)
        if (kind == hourglass_stiffness) then
-          ! Σ_iI B_iI² in the order of the node loop
-          scale = ((((((((0.0_dp + bmat_mid(e, 1, 1)**2) + bmat_mid(e, 2, 1)**2) + bmat_mid(e, 1, 2)**2) &
-               + bmat_mid(e, 2, 2)**2) + bmat_mid(e, 1, 3)**2) + bmat_mid(e, 2, 3)**2) &
-               + bmat_mid(e, 1, 4)**2) + bmat_mid(e, 2, 4)**2)
-          scale = 0.25_dp * modulus(e) * volume_mid(e) * scale
+          ! Σ_iI B_iI² (in the order of the node loop)
+          scale = 0.25_dp * modulus(e) * volume_mid(e) * bsq(e)
           c = coefficient * scale
           ! qc = R_{n+½}ᵀ q; Q^c += K qc; qg = R_{n+1} Q^c
           qc1 = (0.0_dp + rot_mid(e, 1, 1) * q1) + rot_mid(e, 2, 1) * q2
@@ -376,21 +597,21 @@ contains
           energy_inc(e) = 0.0_dp
        end if
        w = 0.0_dp
-       f_old = fe(e, 1, 1); f_new = f_old + qg1 * g1; fe(e, 1, 1) = f_new; df = f_new - f_old
+       f_old = fe_in(e, 1, 1); f_new = f_old + qg1 * g1; fe_out(o, 1, 1) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 1, 1) + df) * du(e, 1, 1); force_hg(e, 1, 1) = df
-       f_old = fe(e, 2, 1); f_new = f_old + qg2 * g1; fe(e, 2, 1) = f_new; df = f_new - f_old
+       f_old = fe_in(e, 2, 1); f_new = f_old + qg2 * g1; fe_out(o, 2, 1) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 2, 1) + df) * du(e, 2, 1); force_hg(e, 2, 1) = df
-       f_old = fe(e, 1, 2); f_new = f_old + qg1 * g2; fe(e, 1, 2) = f_new; df = f_new - f_old
+       f_old = fe_in(e, 1, 2); f_new = f_old + qg1 * g2; fe_out(o, 1, 2) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 1, 2) + df) * du(e, 1, 2); force_hg(e, 1, 2) = df
-       f_old = fe(e, 2, 2); f_new = f_old + qg2 * g2; fe(e, 2, 2) = f_new; df = f_new - f_old
+       f_old = fe_in(e, 2, 2); f_new = f_old + qg2 * g2; fe_out(o, 2, 2) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 2, 2) + df) * du(e, 2, 2); force_hg(e, 2, 2) = df
-       f_old = fe(e, 1, 3); f_new = f_old + qg1 * g3; fe(e, 1, 3) = f_new; df = f_new - f_old
+       f_old = fe_in(e, 1, 3); f_new = f_old + qg1 * g3; fe_out(o, 1, 3) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 1, 3) + df) * du(e, 1, 3); force_hg(e, 1, 3) = df
-       f_old = fe(e, 2, 3); f_new = f_old + qg2 * g3; fe(e, 2, 3) = f_new; df = f_new - f_old
+       f_old = fe_in(e, 2, 3); f_new = f_old + qg2 * g3; fe_out(o, 2, 3) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 2, 3) + df) * du(e, 2, 3); force_hg(e, 2, 3) = df
-       f_old = fe(e, 1, 4); f_new = f_old + qg1 * g4; fe(e, 1, 4) = f_new; df = f_new - f_old
+       f_old = fe_in(e, 1, 4); f_new = f_old + qg1 * g4; fe_out(o, 1, 4) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 1, 4) + df) * du(e, 1, 4); force_hg(e, 1, 4) = df
-       f_old = fe(e, 2, 4); f_new = f_old + qg2 * g4; fe(e, 2, 4) = f_new; df = f_new - f_old
+       f_old = fe_in(e, 2, 4); f_new = f_old + qg2 * g4; fe_out(o, 2, 4) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 2, 4) + df) * du(e, 2, 4); force_hg(e, 2, 4) = df
        work(e) = w
     end do
