@@ -11,7 +11,8 @@ module driver_elements
   use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
        effect_bulk_viscosity, effect_user_field
   use driver_vumat_call, only: vumat_work_t, call_material, vumat_work_init
-  use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_hourglass_update
+  use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_internal_force_bv, &
+       cpe4r_hourglass_update
   use fem_c3d8r, only: c3d8r_kinematics, c3d8r_internal_force, c3d8r_hourglass
   use fem_corotation, only: corotational_increment, deformation_gradient, to_global, vumat_defgrad, &
        vumat_stretch
@@ -36,6 +37,7 @@ module driver_elements
      real(dp), allocatable :: strain_inc(:, :), spin_inc(:, :), strain_corot(:, :), rel_spin(:, :)
      real(dp), allocatable :: r_mid(:, :, :), r_new(:, :, :), f_old(:, :, :), f_new(:, :, :)
      real(dp), allocatable :: rotation_swap(:, :, :)  !< unallocated: holder for the R exchange
+     real(dp), allocatable :: sigma_bv_swap(:)        !< unallocated: holder for the σ_bv exchange
      real(dp), allocatable :: stretch_old(:, :), stretch_new(:, :), defgrad_old(:, :), defgrad_new(:, :)
      real(dp), allocatable :: stress_force(:, :)
      integer, allocatable :: reason(:)
@@ -230,7 +232,7 @@ contains
     integer :: e, nc, ns, a, i, hourglass_kind
     real(dp) :: hourglass_coefficient
     character(len=64) :: text
-    logical :: plane
+    logical :: plane, bulk
 
     nc = solver%ncomp
     ns = solver%nshr
@@ -316,17 +318,21 @@ contains
     ! hourglass see the scaled inertia; the VUMAT above got the physical density.
     if (blk%mass_scaled) w%density(1:nb) = w%density(1:nb) * blk%mass_scale
     w%wave_speed(1:nb) = sqrt(blk%wave_modulus / w%density(1:nb))
-    w%stress_force(1:nb, :) = blk%stress_global
-    w%xi(1:nb) = 0
-    if (effects%active(effect_bulk_viscosity)) then
+    ! CPE4R: the internal-force kernel adds σ_bv itself (no stress copy, no three passes adding it).
+    if (.not. plane) w%stress_force(1:nb, :) = blk%stress_global
+    bulk = effects%active(effect_bulk_viscosity)
+    if (.not. bulk) w%xi(1:nb) = 0
+    if (bulk) then
        call effects%stop(effect_elements)
        call effects%start(effect_bulk_viscosity)
        call bulk_viscosity(nb, nc, w%strain_inc(1:nb, :), dt, w%density(1:nb), w%wave_speed(1:nb), &
             w%char_length(1:nb), w%volume_abs(1:nb), b1, b2, w%sigma_bv(1:nb), w%xi(1:nb), &
             w%e_bv(1:nb))
-       do e = 1, 3
-          w%stress_force(1:nb, e) = w%stress_force(1:nb, e) + w%sigma_bv(1:nb)
-       end do
+       if (.not. plane) then
+          do e = 1, 3
+             w%stress_force(1:nb, e) = w%stress_force(1:nb, e) + w%sigma_bv(1:nb)
+          end do
+       end if
        ! ALLVD with the trapezoidal rule, like the material's stress power: the pressure found now
        ! acts in the forces at t_{n+1}, the previous one in those at t_n, and the balance charges
        ! the work of the forces as ½ (f_n + f_{n+1})·Δu. The kernel's σ_bv^{n+½} tr Δε V alone
@@ -335,14 +341,18 @@ contains
           w%e_bv(e) = 0.5_dp * (blk%sigma_bv(e) + w%sigma_bv(e)) * (w%strain_inc(e, 1) + w%strain_inc(e, 2) &
                + w%strain_inc(e, 3)) * abs(w%volume_mid(e))
        end do
-       blk%sigma_bv = w%sigma_bv(1:nb)
+       ! σ_bv becomes the block's by exchanging the arrays (both have exactly nb elements).
+       call move_alloc(blk%sigma_bv, w%sigma_bv_swap)
+       call move_alloc(w%sigma_bv, blk%sigma_bv)
+       call move_alloc(w%sigma_bv_swap, w%sigma_bv)
        solver%e_viscous = solver%e_viscous + sum(w%e_bv(1:nb))
        call effects%stop(effect_bulk_viscosity)
        call effects%start(effect_elements)
     end if
-    if (plane) then
-       call cpe4r_internal_force(nb, w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%stress_force(1:nb, :), &
-            w%fe(1:nb, :, :))
+    if (plane .and. bulk) then
+       call cpe4r_internal_force_bv(nb, w%volume_new, w%bmat_new, blk%stress_global, blk%sigma_bv, w%fe)
+    else if (plane) then
+       call cpe4r_internal_force(nb, w%volume_new, w%bmat_new, blk%stress_global, w%fe)
     else
        call c3d8r_internal_force(nb, w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%stress_force(1:nb, :), &
             w%fe(1:nb, :, :))

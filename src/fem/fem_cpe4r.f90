@@ -21,7 +21,7 @@ module fem_cpe4r
 
   public :: cpe4r_geometry, cpe4r_char_length, cpe4r_strain_increment, cpe4r_kinematics
   public :: cpe4r_internal_force, cpe4r_hourglass_gamma, cpe4r_hourglass, cpe4r_hourglass_update
-  public :: cpe4r_increment_kinematics
+  public :: cpe4r_increment_kinematics, cpe4r_internal_force_bv
 
   integer, parameter, public :: cpe4r_ndim = 2, cpe4r_nen = 4, cpe4r_ncomp = 4
   integer, parameter, public :: cpe4r_nshr = 1, cpe4r_nmode = 1
@@ -421,6 +421,28 @@ contains
        end do
     end do
   end subroutine cpe4r_internal_force
+
+  !> cpe4r_internal_force of the stress plus the isotropic bulk-viscosity stress σ_bv (added to
+  !> 11 and 22 here, with the sums the solver formed in a copy of the stress before: bitwise the
+  !> same forces, without that copy and its passes). Overwrites fe.
+  pure subroutine cpe4r_internal_force_bv(nb, volume, bmat, stress, sigma_bv, fe)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: volume(nb)
+    real(dp), intent(in) :: bmat(nb, 2, 4)
+    real(dp), intent(in) :: stress(nb, 4), sigma_bv(nb)
+    real(dp), intent(out) :: fe(nb, 2, 4)
+    real(dp) :: s11, s22
+    integer :: e, n
+
+    do n = 1, 4
+       do e = 1, nb
+          s11 = stress(e, 1) + sigma_bv(e)
+          s22 = stress(e, 2) + sigma_bv(e)
+          fe(e, 1, n) = volume(e) * (s11 * bmat(e, 1, n) + stress(e, 4) * bmat(e, 2, n))
+          fe(e, 2, n) = volume(e) * (stress(e, 4) * bmat(e, 1, n) + s22 * bmat(e, 2, n))
+       end do
+    end do
+  end subroutine cpe4r_internal_force_bv
 
   !> Flanagan–Belytschko hourglass shape vector γ_I = h_I − (h·x) B_xI − (h·y) B_yI
   !> (unnormalised: γ = h = (1, −1, 1, −1) for a parallelogram). Orthogonal to every linear
