@@ -270,7 +270,10 @@ contains
        vol = thickness(e) * area
        volume_mid(e) = vol
        volume_abs(e) = abs(vol)
-       density(e) = mass(e) / abs(vol)
+       ! Guarded (the max changes nothing for any valid element): the inversion check now runs
+       ! in this same loop, after which the driver stops, so an inverted or collapsed element
+       ! must not trap here (the debug build traps on 1/0 and 0/0).
+       density(e) = mass(e) / max(abs(vol), tiny(1.0_dp))
        hx = mx1 - mx2 + mx3 - mx4
        hy = my1 - my2 + my3 - my4
        r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
@@ -400,7 +403,8 @@ contains
        d22 = (0.0_dp + n21 * r_old(e, 2, 1)) + n22 * r_old(e, 2, 2)
        d12 = (0.0_dp + n11 * r_old(e, 2, 1)) + n12 * r_old(e, 2, 2)
        d21 = (0.0_dp + n21 * r_old(e, 1, 1)) + n22 * r_old(e, 1, 2)
-       rel_spin(e, 1) = spin - 2.0_dp * (d21 - d12) / (2.0_dp + d11 + d22)
+       ! 1 + tr ΔR > 0 for any rotation below 180° in one increment; guarded like the density.
+       rel_spin(e, 1) = spin - 2.0_dp * (d21 - d12) / max(2.0_dp + d11 + d22, tiny(1.0_dp))
     end do
   end subroutine cpe4r_increment_kinematics
 
