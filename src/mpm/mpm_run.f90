@@ -390,9 +390,9 @@ contains
       do k = 1, size(mpm%walls)
          call wall_find_nodes(mpm%walls(k), st%g, st%wall_nodes(k))
          call mirror_plane_setup(mpm%walls(k), st%g, st%mirror(k), st%mirrored(k))
-         ! a mirrored plane's image nodes are the reflection of the real ones, damped as they are:
-         ! only the plane's own nodes count as wall nodes
-         if (st%mirrored(k)) st%wall_nodes(k)%nodes = st%mirror(k)%plane
+         ! a mirrored plane is no wall to the grid: its nodes and images are damped as the full
+         ! model's would be (the fold leaves them symmetric)
+         if (st%mirrored(k)) st%wall_nodes(k)%nodes = [integer ::]
       end do
 
       fx%active = .false.
