@@ -11,6 +11,9 @@ module mpm_grid
      integer :: nn = 0                      !< nodes in all
      real(dp) :: lo(3) = 0, h = 0
      real(dp), allocatable :: mass(:)       !< (nn)
+     !> (nn) the mass the particles of this model gave each node, before a mirror plane folded
+     !> its image's in (mpm_mirror); weights wall forces and energies. = mass without mirrors.
+     real(dp), allocatable :: mass_own(:)
      real(dp), allocatable :: mom(:, :)     !< (ndim, nn) momentum at t_n (P2G)
      real(dp), allocatable :: force(:, :)   !< (ndim, nn) internal + external force
      real(dp), allocatable :: v_old(:, :)   !< (ndim, nn) velocity at t_n
@@ -39,7 +42,7 @@ contains
        g%n(k) = ceiling((hi(k) - lo(k)) / h - 1.0e-9_dp) + 1
     end do
     g%nn = product(g%n)
-    allocate (g%mass(g%nn), g%mom(ndim, g%nn), g%force(ndim, g%nn), g%v_old(ndim, g%nn), &
+    allocate (g%mass(g%nn), g%mass_own(g%nn), g%mom(ndim, g%nn), g%force(ndim, g%nn), g%v_old(ndim, g%nn), &
          g%v_new(ndim, g%nn), g%active(g%nn))
     call grid_reset(g)
   end subroutine grid_init
@@ -47,6 +50,7 @@ contains
   subroutine grid_reset(g)
     type(grid_t), intent(inout) :: g
     g%mass = 0
+    g%mass_own = 0
     g%mom = 0
     g%force = 0
     g%v_old = 0

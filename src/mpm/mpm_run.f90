@@ -36,6 +36,7 @@ module mpm_run
   use mpm_shape, only: stencil_nodes_per_direction, block_stencil
   use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance, &
        wall_slide_velocity
+  use mpm_mirror, only: mirror_plane_t, mirror_plane_setup, mirror_fold, mirror_fold_momentum
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close
   use driver_vumat_call, only: vumat_work_t, vumat_work_init, call_material, packaging_modulus
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
@@ -69,6 +70,9 @@ module mpm_run
      integer :: nblocks = 0
      type(particle_block_t), allocatable :: blocks(:)
      type(wall_nodes_t), allocatable :: wall_nodes(:)
+     !> per wall: a symmetry plane on a node plane is done by mirroring the grid (mpm_mirror)
+     type(mirror_plane_t), allocatable :: mirror(:)
+     logical, allocatable :: mirrored(:)
      real(dp), allocatable :: modulus(:)             !< per material: λ + 2G (packaging call)
      logical, allocatable :: needs_kinematics(:)     !< per material: user VUMAT reads F, U
      type(vumat_work_t) :: work
@@ -382,8 +386,13 @@ contains
       st%wall_force = 0
       st%wall_impulse = 0
       st%wall_force_row = 0
+      allocate (st%mirror(size(mpm%walls)), st%mirrored(size(mpm%walls)))
       do k = 1, size(mpm%walls)
          call wall_find_nodes(mpm%walls(k), st%g, st%wall_nodes(k))
+         call mirror_plane_setup(mpm%walls(k), st%g, st%mirror(k), st%mirrored(k))
+         ! a mirrored plane is no wall to the grid: its nodes and images are damped as the full
+         ! model's would be (the fold leaves them symmetric)
+         if (st%mirrored(k)) st%wall_nodes(k)%nodes = [integer ::]
       end do
 
       fx%active = .false.
@@ -606,6 +615,12 @@ contains
        call p2g(st, st%blocks(ib))
     end do
     if (st%nranks > 1) call reduce_grid(st, .true.)
+    st%g%mass_own = st%g%mass
+    st%wall_force = 0
+    do k = 1, size(m%mpm%walls)
+       if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) &
+            call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k))
+    end do
     call timer_stop(fx%timers, fx%id(fx_p2g))
 
     ! grid update
@@ -614,10 +629,9 @@ contains
     call timer_stop(fx%timers, fx%id(fx_grid))
     if (fx%active(fx_walls)) then
        call timer_start(fx%timers, fx%id(fx_walls))
-       st%wall_force = 0
        do k = 1, size(m%mpm%walls)
-          if (.not. m%mpm%walls(k)%active(s)) cycle
-          call wall_project(m%mpm%walls(k), st%wall_nodes(k), st%nd, st%g%mass, st%g%active, st%g%v_new, &
+          if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
+          call wall_project(m%mpm%walls(k), st%wall_nodes(k), st%nd, st%g%mass_own, st%g%active, st%g%v_new, &
                st%dt, st%wall_force(:, k), st%e_walls)
        end do
        st%wall_impulse = st%wall_impulse + st%dt * st%wall_force
@@ -632,6 +646,9 @@ contains
        call g2p(m, st, st%blocks(ib))
     end do
     if (st%nranks > 1) call reduce_grid(st, .false.)
+    do k = 1, size(m%mpm%walls)
+       if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
+    end do
     do i = 1, st%g%nn
        if (st%g%active(i)) then
           st%g%v_new(:, i) = st%g%mom(:, i) / st%g%mass(i)
@@ -643,7 +660,7 @@ contains
     if (fx%active(fx_walls)) then
        call timer_start(fx%timers, fx%id(fx_walls))
        do k = 1, size(m%mpm%walls)
-          if (.not. m%mpm%walls(k)%active(s)) cycle
+          if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
           call wall_project(m%mpm%walls(k), st%wall_nodes(k), st%nd, st%g%mass, st%g%active, st%g%v_new, st%dt)
        end do
        call timer_stop(fx%timers, fx%id(fx_walls))
@@ -870,7 +887,8 @@ contains
              ! Cundall's local non-viscous damping: opposes the motion, proportional to |f|
              damp = a * abs(f)
              f = f - sign(damp, st%g%v_old(k, i))
-             st%e_damping = st%e_damping + damp * abs(st%g%v_old(k, i)) * dt
+             ! the real material's share of the node (image mass folded in: mpm_mirror)
+             st%e_damping = st%e_damping + damp * abs(st%g%v_old(k, i)) * dt * st%g%mass_own(i) / st%g%mass(i)
           end if
           st%g%v_new(k, i) = st%g%v_old(k, i) + dt * f / st%g%mass(i)
        end do

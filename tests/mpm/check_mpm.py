@@ -13,6 +13,10 @@ kinds:
   mpi        the same hopper on 1 rank and twice on 2 ranks (--mpiexec): the 2-rank runs are
              identical (deterministic), the fill step agrees with 1 rank to round-off (1e-9),
              exact mass balance and particle counts on 2 ranks, the frame holds every particle
+  mirror     a symmetric collapse as a half model (symmetry plane on a node line; the scene given)
+             and as the full model (mirror_full_2d.inp beside it): every half-model particle
+             follows its full-model twin to 1e-6 m, energies are half the full model's to 1e-6,
+             no particle is put back onto the plane (GUARDED = 0): src/mpm/mpm_mirror.f90
   mass       hopper with outlet, outflow and inflow: initial + in - out = in domain exactly
              (particle counts exact, masses to round-off), and both flows present
 Every kind also checks the effects line and the timing table (MPM effects with shares).
@@ -181,6 +185,35 @@ def mass(args):
           f"integral of MDR = {integral:.6g} kg = MASS_OUT")
 
 
+def mirror(args):
+    half_base, out, half = run(args.bulkflow, args.scene, args.workdir)
+    check_report(out, ["walls", "damping"])
+    full_scene = str(Path(args.scene).with_name("mirror_full_2d.inp"))
+    full_base, _, full = run(args.bulkflow, full_scene, args.workdir)
+
+    def by_start(base):
+        f = h5py.File(str(base) + ".h5", "r")
+        frames = sorted(f["particles"].keys())
+        first, last = f["particles"][frames[0]], f["particles"][frames[-1]]
+        start = dict(zip(first["id"][:], np.round(first["coordinates"][:, :2], 9).tolist()))
+        end = dict(zip(last["id"][:], last["coordinates"][:, :2].tolist()))
+        return {tuple(start[i]): np.array(end[i]) for i in end}
+
+    h, fl = by_start(half_base), by_start(full_base)
+    twins = [(h[k], fl[k]) for k in h if k in fl]
+    check(len(twins) == len(h) and 2 * len(h) == len(fl),
+          f"{len(h)} half-model particles, each with a twin among the {len(fl)} of the full model")
+    worst = max(np.abs(a - b).max() for a, b in twins)
+    moved = max(np.abs(b - np.array(k)).max() for k, b in ((k, fl[k]) for k in h))
+    check(moved > 0.05, f"the column collapses: the largest displacement is {moved:.3f} m")
+    check(worst < 1e-6, f"half model follows the full model: max position difference {worst:.2e} m")
+    for k in ["ALLKE", "ALLIE", "ALLWK", "ALLDMD"]:
+        rel = abs(2 * half[k][-1] - full[k][-1]) / abs(full[k][-1])
+        check(rel < 1e-6, f"{k}: 2 x half {2 * half[k][-1]:.6g} vs full {full[k][-1]:.6g} (rel {rel:.1e})")
+    check(half["GUARDED"][-1] == 0, f"no particle put back onto the plane (GUARDED {half['GUARDED'][-1]:g})")
+    mass_balance(half)
+
+
 def mpi(args):
     import filecmp
     import os
@@ -216,7 +249,7 @@ def mpi(args):
 
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("kind", choices=["column", "incline", "heap", "mass", "mpi"])
+    p.add_argument("kind", choices=["column", "incline", "heap", "mirror", "mass", "mpi"])
     p.add_argument("--mpiexec", default="mpirun")
     p.add_argument("scene")
     p.add_argument("--bulkflow", required=True)

@@ -27,8 +27,10 @@ from .paths import frames, outlet_path
 DEFAULT_EXE = str(Path(__file__).resolve().parents[3] / "build" / "bin" / "bulkflow")
 # Bumped whenever the MPM solver's physics changes, so cached runs of an older solver are not
 # read back as this one's (part of every run's name). 1: session 2's solver; 2: the particle
-# put-back behind a wall applies the wall's Coulomb friction (before: frictionless).
-MPM_REVISION = 2
+# put-back behind a wall applies the wall's Coulomb friction (before: frictionless); 3: symmetry
+# planes on node planes mirror the grid (mpm_mirror), nodes within 1e-6 h of a wall are on it,
+# the scene writes the cell in full.
+MPM_REVISION = 3
 RUN_DEFAULTS = dict(field_frames=5, history_dt=0.01)
 
 
