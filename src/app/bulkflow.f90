@@ -9,13 +9,14 @@
 !> BASE defaults to the scene's file name without its extension, in the working directory.
 program bulkflow
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-  use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_Abort, MPI_COMM_WORLD, MPI_Comm_rank, MPI_Comm_size
+  use mpi_f08, only: MPI_Init, MPI_Finalize, MPI_COMM_WORLD, MPI_Comm_rank, MPI_Comm_size
   use error_report, only: error_t, set_final_stop
   use model, only: model_t
   use scene_reader, only: read_scene
   use driver_run, only: run_options_t, run_scene
   use mpm_run, only: mpm_run_scene
   use abaqus_host, only: host_set_exit_handler
+  use parallel_abort, only: abort_all, abort_all_status
   implicit none
   type(model_t) :: m
   type(error_t) :: err
@@ -138,13 +139,4 @@ contains
     if (e%raised) call input_error_exit(e)
     call mpm_run_scene(m, opts%output_base, opts%progress, opts%stop_after, MPI_COMM_WORLD)
   end subroutine run_mpm
-
-  subroutine abort_all()
-    call MPI_Abort(MPI_COMM_WORLD, 2)
-  end subroutine abort_all
-
-  subroutine abort_all_status(status)
-    integer, intent(in) :: status
-    call MPI_Abort(MPI_COMM_WORLD, status)
-  end subroutine abort_all_status
 end program bulkflow
