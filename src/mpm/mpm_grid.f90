@@ -23,7 +23,7 @@ module mpm_grid
      procedure :: position => grid_position
   end type grid_t
 
-  public :: grid_init, grid_reset
+  public :: grid_init, grid_reset, grid_node_index
 
 contains
 
@@ -63,14 +63,21 @@ contains
     class(grid_t), intent(in) :: g
     integer, intent(in) :: node
     real(dp) :: x(3)
-    integer :: r, i, j, k
 
-    r = node - 1
-    i = mod(r, g%n(1))
-    r = r / g%n(1)
-    j = mod(r, g%n(2))
-    k = r / g%n(2)
-    x = g%lo + g%h * [real(dp) :: i, j, k]
+    x = g%lo + g%h * real(grid_node_index(g, node), dp)
     if (g%ndim == 2) x(3) = 0
   end function grid_position
+
+  !> The 0-based (i, j, k) of node `node` (1-based index; k = 0 in 2D).
+  pure function grid_node_index(g, node) result(idx)
+    type(grid_t), intent(in) :: g
+    integer, intent(in) :: node
+    integer :: idx(3), r
+
+    r = node - 1
+    idx(1) = mod(r, g%n(1))
+    r = r / g%n(1)
+    idx(2) = mod(r, g%n(2))
+    idx(3) = r / g%n(2)
+  end function grid_node_index
 end module mpm_grid

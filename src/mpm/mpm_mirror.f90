@@ -18,7 +18,7 @@
 module mpm_mirror
   use material_kinds, only: dp
   use mpm_scene, only: mpm_wall_t, wall_symmetry
-  use mpm_grid, only: grid_t
+  use mpm_grid, only: grid_t, grid_node_index
   use mpm_walls, only: wall_contains, node_on_wall_tolerance
   implicit none
   private
@@ -61,7 +61,7 @@ contains
     np = 0
     nf = 0
     do i = 1, g%nn
-       idx = node_index(g, i)
+       idx = grid_node_index(g, i)
        ! only where the wall extends (its segment / box, as the projection walls)
        x = g%position(i)
        x(axis) = w%p0(axis)
@@ -86,18 +86,6 @@ contains
     mp%back = back(1:nf)
     ok = .true.
   end subroutine mirror_plane_setup
-
-  pure function node_index(g, node) result(idx)
-    type(grid_t), intent(in) :: g
-    integer, intent(in) :: node
-    integer :: idx(3), r
-
-    r = node - 1
-    idx(1) = mod(r, g%n(1))
-    r = r / g%n(1)
-    idx(2) = mod(r, g%n(2))
-    idx(3) = r / g%n(2)
-  end function node_index
 
   !> Fold mass, momentum and force of the P2G across the plane (the grid's mass before any fold
   !> is in g%mass_own, set by the caller). Returns the force the material exerts on the plane.
