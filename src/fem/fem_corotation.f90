@@ -14,6 +14,7 @@
 !> Plane strain (ndim 2): R is an in-plane rotation, R33 = 1, and the 33 component is untouched.
 module fem_corotation
   use material_kinds, only: dp
+  use fem_plane_frame, only: plane_defgrad, plane_rotation, plane_similarity, plane_relative_spin
   implicit none
   private
 
@@ -80,9 +81,7 @@ contains
     real(dp), intent(in) :: r_old(nb, 2, 2)
     real(dp), intent(out) :: r_mid(nb, 2, 2), r_new(nb, 2, 2), f_new(nb, 2, 2)
     real(dp), intent(out) :: strain_inc_corot(nb, 4), rel_spin(nb, 1)
-    real(dp) :: x2, x3, x4, y2, y3, y4, f11, f21, f12, f22, c, s, nrm
-    real(dp) :: q11, q12, q21, q22, a11, a22, a12, t11, t12, t21, t22, u12, u21
-    real(dp) :: n11, n12, n21, n22, d11, d22, d12, d21
+    real(dp) :: f11, f21, f12, f22, q11, q12, q21, q22, n11, n12, n21, n22
     integer :: e
 
     ! ivdep: the dummies do not alias (Fortran); without it the compiler wanted more run-time
@@ -90,73 +89,38 @@ contains
     !GCC$ ivdep
     do e = 1, nb
        ! F_{n+½} and R_{n+½} (deformation_gradient, polar_rotation)
-       x2 = xe_mid(e, 1, 2) - xe_mid(e, 1, 1)
-       x3 = xe_mid(e, 1, 3) - xe_mid(e, 1, 1)
-       x4 = xe_mid(e, 1, 4) - xe_mid(e, 1, 1)
-       y2 = xe_mid(e, 2, 2) - xe_mid(e, 2, 1)
-       y3 = xe_mid(e, 2, 3) - xe_mid(e, 2, 1)
-       y4 = xe_mid(e, 2, 4) - xe_mid(e, 2, 1)
-       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
-       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
-       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
-       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
-       c = f11 + f22
-       s = f21 - f12
-       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
-       q11 = c / nrm
-       q21 = s / nrm
-       q12 = -s / nrm
-       q22 = c / nrm
+       call plane_defgrad(xe_mid(e, 1, 2) - xe_mid(e, 1, 1), xe_mid(e, 1, 3) - xe_mid(e, 1, 1), &
+            xe_mid(e, 1, 4) - xe_mid(e, 1, 1), xe_mid(e, 2, 2) - xe_mid(e, 2, 1), &
+            xe_mid(e, 2, 3) - xe_mid(e, 2, 1), xe_mid(e, 2, 4) - xe_mid(e, 2, 1), &
+            bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
+            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
+       call plane_rotation(f11, f21, f12, f22, q11, q21, q12, q22)
        r_mid(e, 1, 1) = q11
        r_mid(e, 2, 1) = q21
        r_mid(e, 1, 2) = q12
        r_mid(e, 2, 2) = q22
        ! F_{n+1} and R_{n+1}
-       x2 = xe_new(e, 1, 2) - xe_new(e, 1, 1)
-       x3 = xe_new(e, 1, 3) - xe_new(e, 1, 1)
-       x4 = xe_new(e, 1, 4) - xe_new(e, 1, 1)
-       y2 = xe_new(e, 2, 2) - xe_new(e, 2, 1)
-       y3 = xe_new(e, 2, 3) - xe_new(e, 2, 1)
-       y4 = xe_new(e, 2, 4) - xe_new(e, 2, 1)
-       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
-       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
-       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
-       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       call plane_defgrad(xe_new(e, 1, 2) - xe_new(e, 1, 1), xe_new(e, 1, 3) - xe_new(e, 1, 1), &
+            xe_new(e, 1, 4) - xe_new(e, 1, 1), xe_new(e, 2, 2) - xe_new(e, 2, 1), &
+            xe_new(e, 2, 3) - xe_new(e, 2, 1), xe_new(e, 2, 4) - xe_new(e, 2, 1), &
+            bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
+            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
        f_new(e, 1, 1) = f11
        f_new(e, 2, 1) = f21
        f_new(e, 1, 2) = f12
        f_new(e, 2, 2) = f22
-       c = f11 + f22
-       s = f21 - f12
-       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
-       n11 = c / nrm
-       n21 = s / nrm
-       n12 = -s / nrm
-       n22 = c / nrm
+       call plane_rotation(f11, f21, f12, f22, n11, n21, n12, n22)
        r_new(e, 1, 1) = n11
        r_new(e, 2, 1) = n21
        r_new(e, 1, 2) = n12
        r_new(e, 2, 2) = n22
        ! strainInc = R_{n+½}ᵀ Δε R_{n+½} (rotate_symmetric_2d with q = R_{n+½}ᵀ: q12 = R21, q21 = R12)
-       a11 = strain_inc(e, 1)
-       a22 = strain_inc(e, 2)
-       a12 = strain_inc(e, 4)
-       t11 = (0.0_dp + a11 * q11) + a12 * q21
-       t12 = (0.0_dp + a11 * q12) + a12 * q22
-       t21 = (0.0_dp + a12 * q11) + a22 * q21
-       t22 = (0.0_dp + a12 * q12) + a22 * q22
-       strain_inc_corot(e, 1) = (0.0_dp + q11 * t11) + q21 * t21
-       strain_inc_corot(e, 2) = (0.0_dp + q12 * t12) + q22 * t22
+       call plane_similarity(q11, q21, q12, q22, strain_inc(e, 1), strain_inc(e, 2), strain_inc(e, 4), &
+            strain_inc_corot(e, 1), strain_inc_corot(e, 2), strain_inc_corot(e, 4))
        strain_inc_corot(e, 3) = strain_inc(e, 3)
-       u12 = (0.0_dp + q11 * t12) + q21 * t22
-       u21 = (0.0_dp + q12 * t11) + q22 * t21
-       strain_inc_corot(e, 4) = 0.5_dp * (u12 + u21)
        ! relSpinInc (relative_spin): ΔR = R_{n+1} R_nᵀ
-       d11 = (0.0_dp + n11 * r_old(e, 1, 1)) + n12 * r_old(e, 1, 2)
-       d22 = (0.0_dp + n21 * r_old(e, 2, 1)) + n22 * r_old(e, 2, 2)
-       d12 = (0.0_dp + n11 * r_old(e, 2, 1)) + n12 * r_old(e, 2, 2)
-       d21 = (0.0_dp + n21 * r_old(e, 1, 1)) + n22 * r_old(e, 1, 2)
-       rel_spin(e, 1) = spin_inc(e, 1) - 2.0_dp * (d21 - d12) / (2.0_dp + d11 + d22)
+       rel_spin(e, 1) = plane_relative_spin(spin_inc(e, 1), n11, n21, n12, n22, r_old(e, 1, 1), &
+            r_old(e, 2, 1), r_old(e, 1, 2), r_old(e, 2, 2))
     end do
   end subroutine corotational_increment_2d
 
@@ -170,22 +134,15 @@ contains
     real(dp), intent(in) :: xe(nb, ndim, nen)
     real(dp), intent(out) :: f(nb, ndim, ndim)
     integer :: i, j, n, e
-    real(dp) :: x2, x3, x4, y2, y3, y4
 
     if (ndim == 2 .and. nen == 4) then
        ! CPE4R: one pass with the sums of the general loop below in the same order (bitwise the
        ! same F), instead of zeroing F and updating it three times.
        do e = 1, nb
-          x2 = xe(e, 1, 2) - xe(e, 1, 1)
-          x3 = xe(e, 1, 3) - xe(e, 1, 1)
-          x4 = xe(e, 1, 4) - xe(e, 1, 1)
-          y2 = xe(e, 2, 2) - xe(e, 2, 1)
-          y3 = xe(e, 2, 3) - xe(e, 2, 1)
-          y4 = xe(e, 2, 4) - xe(e, 2, 1)
-          f(e, 1, 1) = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
-          f(e, 2, 1) = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
-          f(e, 1, 2) = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
-          f(e, 2, 2) = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+          call plane_defgrad(xe(e, 1, 2) - xe(e, 1, 1), xe(e, 1, 3) - xe(e, 1, 1), xe(e, 1, 4) - xe(e, 1, 1), &
+               xe(e, 2, 2) - xe(e, 2, 1), xe(e, 2, 3) - xe(e, 2, 1), xe(e, 2, 4) - xe(e, 2, 1), &
+               bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
+               bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f(e, 1, 1), f(e, 2, 1), f(e, 1, 2), f(e, 2, 2))
        end do
        return
     end if
@@ -226,21 +183,14 @@ contains
     integer, intent(in) :: nb, ndim
     real(dp), intent(in) :: f(nb, ndim, ndim)
     real(dp), intent(out) :: r(nb, ndim, ndim)
-    real(dp) :: c, s, nrm
     integer :: e
 
     if (ndim == 2) then
        ! One loop with scalars: block-sized automatic arrays are heap-allocated by gfortran,
        ! a malloc/free pair each per call.
        do e = 1, nb
-          c = f(e, 1, 1) + f(e, 2, 2)
-          s = f(e, 2, 1) - f(e, 1, 2)
-          ! ‖·‖² = ‖F‖² + 2 det F > 0 for a non-inverted element; the guard only avoids 0/0.
-          nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
-          r(e, 1, 1) = c / nrm
-          r(e, 2, 1) = s / nrm
-          r(e, 1, 2) = -s / nrm
-          r(e, 2, 2) = c / nrm
+          call plane_rotation(f(e, 1, 1), f(e, 2, 1), f(e, 1, 2), f(e, 2, 2), r(e, 1, 1), r(e, 2, 1), &
+               r(e, 1, 2), r(e, 2, 2))
        end do
     else
        call polar_rotation_3d(nb, f, r)
@@ -570,7 +520,6 @@ contains
     logical, intent(in) :: transposed
     real(dp), intent(in) :: a(nb, 4)
     real(dp), intent(out) :: b(nb, 4)
-    real(dp) :: q11, q12, q21, q22, a11, a22, a12, t11, t12, t21, t22, u12, u21
     integer :: e, i, j
 
     ! q = R or Rᵀ: q12 = r(:, i, j), q21 = r(:, j, i). Chosen outside the loop, which then
@@ -578,24 +527,9 @@ contains
     i = merge(2, 1, transposed)
     j = 3 - i
     do e = 1, nb
-       q11 = r(e, 1, 1)
-       q22 = r(e, 2, 2)
-       q12 = r(e, i, j)
-       q21 = r(e, j, i)
-       a11 = a(e, 1)
-       a22 = a(e, 2)
-       a12 = a(e, 4)
-       ! t = a qᵀ, then b = q t
-       t11 = (0.0_dp + a11 * q11) + a12 * q12
-       t12 = (0.0_dp + a11 * q21) + a12 * q22
-       t21 = (0.0_dp + a12 * q11) + a22 * q12
-       t22 = (0.0_dp + a12 * q21) + a22 * q22
-       b(e, 1) = (0.0_dp + q11 * t11) + q12 * t21
-       b(e, 2) = (0.0_dp + q21 * t12) + q22 * t22
+       call plane_similarity(r(e, 1, 1), r(e, i, j), r(e, j, i), r(e, 2, 2), a(e, 1), a(e, 2), a(e, 4), &
+            b(e, 1), b(e, 2), b(e, 4))
        b(e, 3) = a(e, 3)
-       u12 = (0.0_dp + q11 * t12) + q12 * t22
-       u21 = (0.0_dp + q21 * t11) + q22 * t21
-       b(e, 4) = 0.5_dp * (u12 + u21)
     end do
   end subroutine rotate_symmetric_2d
 
@@ -611,18 +545,13 @@ contains
     real(dp), intent(in) :: spin_inc(nb, 2 * ndim - 3)
     real(dp), intent(in) :: r_old(nb, ndim, ndim), r_new(nb, ndim, ndim), r_mid(nb, ndim, ndim)
     real(dp), intent(out) :: rel_spin(nb, 2 * ndim - 3)
-    real(dp) :: d11, d22, d12, d21
     integer :: e
 
     if (ndim == 2) then
        ! One loop on scalars (no block temporaries); the same sums in the same order as below.
        do e = 1, nb
-          d11 = (0.0_dp + r_new(e, 1, 1) * r_old(e, 1, 1)) + r_new(e, 1, 2) * r_old(e, 1, 2)
-          d22 = (0.0_dp + r_new(e, 2, 1) * r_old(e, 2, 1)) + r_new(e, 2, 2) * r_old(e, 2, 2)
-          d12 = (0.0_dp + r_new(e, 1, 1) * r_old(e, 2, 1)) + r_new(e, 1, 2) * r_old(e, 2, 2)
-          d21 = (0.0_dp + r_new(e, 2, 1) * r_old(e, 1, 1)) + r_new(e, 2, 2) * r_old(e, 1, 2)
-          ! 1 + tr ΔR of the 3-D embedding (ΔR33 = 1)
-          rel_spin(e, 1) = spin_inc(e, 1) - 2.0_dp * (d21 - d12) / (2.0_dp + d11 + d22)
+          rel_spin(e, 1) = plane_relative_spin(spin_inc(e, 1), r_new(e, 1, 1), r_new(e, 2, 1), r_new(e, 1, 2), &
+               r_new(e, 2, 2), r_old(e, 1, 1), r_old(e, 2, 1), r_old(e, 1, 2), r_old(e, 2, 2))
        end do
     else
        call relative_spin_nd(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)

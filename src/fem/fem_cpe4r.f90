@@ -15,6 +15,7 @@
 module fem_cpe4r
   use material_kinds, only: dp
   use fem_hourglass, only: hourglass_viscous, hourglass_stiffness
+  use fem_plane_frame, only: plane_defgrad, plane_rotation, plane_similarity, plane_relative_spin
   use fem_inversion, only: inversion_none, inversion_centre, inversion_corner, inversion_collapse
   implicit none
   private
@@ -233,9 +234,7 @@ contains
     real(dp) :: mx1, mx2, mx3, mx4, my1, my2, my3, my4, nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4
     real(dp) :: dx, dy, ex, ey, area, r2a, l2max, vol, jmin, hx, hy
     real(dp) :: b11, b12, b13, b14, b21, b22, b23, b24, l11, l12, l21, l22, spin
-    real(dp) :: x2, x3, x4, y2, y3, y4, f11, f21, f12, f22, c, s, nrm
-    real(dp) :: q11, q12, q21, q22, a11, a22, a12, t11, t12, t21, t22, u12, u21
-    real(dp) :: n11, n12, n21, n22, d11, d22, d12, d21
+    real(dp) :: f11, f21, f12, f22, q11, q12, q21, q22, n11, n12, n21, n22
     integer :: e, r
 
     ! ivdep: the dummies do not alias (Fortran); the compiler's run-time alias checks for this
@@ -336,75 +335,34 @@ contains
        if (vol <= 0.0_dp) r = inversion_centre
        reason(e) = r
 
-       ! corotational_increment_2d: F_{n+½} and R_{n+½}
-       x2 = mx2 - mx1
-       x3 = mx3 - mx1
-       x4 = mx4 - mx1
-       y2 = my2 - my1
-       y3 = my3 - my1
-       y4 = my4 - my1
-       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
-       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
-       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
-       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
-       c = f11 + f22
-       s = f21 - f12
-       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
-       q11 = c / nrm
-       q21 = s / nrm
-       q12 = -s / nrm
-       q22 = c / nrm
+       ! corotational_increment_2d: F_{n+½} and R_{n+½}, F_{n+1} and R_{n+1}
+       call plane_defgrad(mx2 - mx1, mx3 - mx1, mx4 - mx1, my2 - my1, my3 - my1, my4 - my1, &
+            bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
+            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
+       call plane_rotation(f11, f21, f12, f22, q11, q21, q12, q22)
        r_mid(e, 1, 1) = q11
        r_mid(e, 2, 1) = q21
        r_mid(e, 1, 2) = q12
        r_mid(e, 2, 2) = q22
-       ! F_{n+1} and R_{n+1}
-       x2 = nx2 - nx1
-       x3 = nx3 - nx1
-       x4 = nx4 - nx1
-       y2 = ny2 - ny1
-       y3 = ny3 - ny1
-       y4 = ny4 - ny1
-       f11 = ((0.0_dp + x2 * bmat_ref(e, 1, 2)) + x3 * bmat_ref(e, 1, 3)) + x4 * bmat_ref(e, 1, 4)
-       f21 = ((0.0_dp + y2 * bmat_ref(e, 1, 2)) + y3 * bmat_ref(e, 1, 3)) + y4 * bmat_ref(e, 1, 4)
-       f12 = ((0.0_dp + x2 * bmat_ref(e, 2, 2)) + x3 * bmat_ref(e, 2, 3)) + x4 * bmat_ref(e, 2, 4)
-       f22 = ((0.0_dp + y2 * bmat_ref(e, 2, 2)) + y3 * bmat_ref(e, 2, 3)) + y4 * bmat_ref(e, 2, 4)
+       call plane_defgrad(nx2 - nx1, nx3 - nx1, nx4 - nx1, ny2 - ny1, ny3 - ny1, ny4 - ny1, &
+            bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
+            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
        f_new(e, 1, 1) = f11
        f_new(e, 2, 1) = f21
        f_new(e, 1, 2) = f12
        f_new(e, 2, 2) = f22
-       c = f11 + f22
-       s = f21 - f12
-       nrm = max(sqrt(c * c + s * s), tiny(1.0_dp))
-       n11 = c / nrm
-       n21 = s / nrm
-       n12 = -s / nrm
-       n22 = c / nrm
+       call plane_rotation(f11, f21, f12, f22, n11, n21, n12, n22)
        r_new(e, 1, 1) = n11
        r_new(e, 2, 1) = n21
        r_new(e, 1, 2) = n12
        r_new(e, 2, 2) = n22
-       ! strainInc = R_{n+½}ᵀ Δε R_{n+½}
-       a11 = l11
-       a22 = l22
-       a12 = 0.5_dp * (l12 + l21)
-       t11 = (0.0_dp + a11 * q11) + a12 * q21
-       t12 = (0.0_dp + a11 * q12) + a12 * q22
-       t21 = (0.0_dp + a12 * q11) + a22 * q21
-       t22 = (0.0_dp + a12 * q12) + a22 * q22
-       strain_inc_corot(e, 1) = (0.0_dp + q11 * t11) + q21 * t21
-       strain_inc_corot(e, 2) = (0.0_dp + q12 * t12) + q22 * t22
+       ! strainInc = R_{n+½}ᵀ Δε R_{n+½} (q a qᵀ with q = R_{n+½}ᵀ)
+       call plane_similarity(q11, q21, q12, q22, l11, l22, 0.5_dp * (l12 + l21), &
+            strain_inc_corot(e, 1), strain_inc_corot(e, 2), strain_inc_corot(e, 4))
        strain_inc_corot(e, 3) = 0.0_dp
-       u12 = (0.0_dp + q11 * t12) + q21 * t22
-       u21 = (0.0_dp + q12 * t11) + q22 * t21
-       strain_inc_corot(e, 4) = 0.5_dp * (u12 + u21)
        ! relSpinInc: ΔR = R_{n+1} R_nᵀ
-       d11 = (0.0_dp + n11 * r_old(e, 1, 1)) + n12 * r_old(e, 1, 2)
-       d22 = (0.0_dp + n21 * r_old(e, 2, 1)) + n22 * r_old(e, 2, 2)
-       d12 = (0.0_dp + n11 * r_old(e, 2, 1)) + n12 * r_old(e, 2, 2)
-       d21 = (0.0_dp + n21 * r_old(e, 1, 1)) + n22 * r_old(e, 1, 2)
-       ! 1 + tr ΔR > 0 for any rotation below 180° in one increment; guarded like the density.
-       rel_spin(e, 1) = spin - 2.0_dp * (d21 - d12) / max(2.0_dp + d11 + d22, tiny(1.0_dp))
+       rel_spin(e, 1) = plane_relative_spin(spin, n11, n21, n12, n22, r_old(e, 1, 1), r_old(e, 2, 1), &
+            r_old(e, 1, 2), r_old(e, 2, 2))
     end do
   end subroutine cpe4r_increment_kinematics
 
