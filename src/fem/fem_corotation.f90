@@ -52,12 +52,8 @@ contains
     real(dp), intent(out) :: strain_inc_corot(nb, 2 * ndim), rel_spin(nb, 2 * ndim - 3)
     real(dp), allocatable :: f_mid(:, :, :)
 
-    if (ndim == 2 .and. nen == 4) then
-       call corotational_increment_2d(nb, bmat_ref, xe_mid, xe_new, strain_inc, spin_inc, r_old, &
-            r_mid, r_new, f_new, strain_inc_corot, rel_spin)
-       return
-    end if
-    ! 3D: F_{n+½} is only needed here (allocated, not automatic: the 2D path needs no memory).
+    ! The solver's CPE4R pass does this step inside fem_cpe4r's fused kernel, with the same
+    ! plane-frame kernels (fem_plane_frame) as the pieces below, so both agree to the bit.
     allocate(f_mid(nb, ndim, ndim))
     call deformation_gradient(nb, ndim, nen, bmat_ref, xe_mid, f_mid)
     call polar_rotation(nb, ndim, f_mid, r_mid)
@@ -66,63 +62,6 @@ contains
     call to_corotational(nb, ndim, 2 * ndim, r_mid, strain_inc, strain_inc_corot)
     call relative_spin(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
   end subroutine corotational_increment
-
-  !> corotational_increment for CPE4R as one element loop on scalars: F_{n+½} and R_{n+½} never
-  !> leave registers, and each element's data is read once (before: six passes over the block
-  !> and a heap-allocated F_{n+½}). Every quantity is the same sum, in the same order, as in
-  !> deformation_gradient, polar_rotation, rotate_symmetric_2d and relative_spin, so the results
-  !> are the same to the bit.
-  pure subroutine corotational_increment_2d(nb, bmat_ref, xe_mid, xe_new, strain_inc, spin_inc, &
-                                            r_old, r_mid, r_new, f_new, strain_inc_corot, rel_spin)
-    integer, intent(in) :: nb
-    real(dp), intent(in) :: bmat_ref(nb, 2, 4)
-    real(dp), intent(in) :: xe_mid(nb, 2, 4), xe_new(nb, 2, 4)
-    real(dp), intent(in) :: strain_inc(nb, 4), spin_inc(nb, 1)
-    real(dp), intent(in) :: r_old(nb, 2, 2)
-    real(dp), intent(out) :: r_mid(nb, 2, 2), r_new(nb, 2, 2), f_new(nb, 2, 2)
-    real(dp), intent(out) :: strain_inc_corot(nb, 4), rel_spin(nb, 1)
-    real(dp) :: f11, f21, f12, f22, q11, q12, q21, q22, n11, n12, n21, n22
-    integer :: e
-
-    ! ivdep: the dummies do not alias (Fortran); without it the compiler wanted more run-time
-    ! alias checks than its limit and left the loop scalar.
-    !GCC$ ivdep
-    do e = 1, nb
-       ! F_{n+½} and R_{n+½} (deformation_gradient, polar_rotation)
-       call plane_defgrad(xe_mid(e, 1, 2) - xe_mid(e, 1, 1), xe_mid(e, 1, 3) - xe_mid(e, 1, 1), &
-            xe_mid(e, 1, 4) - xe_mid(e, 1, 1), xe_mid(e, 2, 2) - xe_mid(e, 2, 1), &
-            xe_mid(e, 2, 3) - xe_mid(e, 2, 1), xe_mid(e, 2, 4) - xe_mid(e, 2, 1), &
-            bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
-            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
-       call plane_rotation(f11, f21, f12, f22, q11, q21, q12, q22)
-       r_mid(e, 1, 1) = q11
-       r_mid(e, 2, 1) = q21
-       r_mid(e, 1, 2) = q12
-       r_mid(e, 2, 2) = q22
-       ! F_{n+1} and R_{n+1}
-       call plane_defgrad(xe_new(e, 1, 2) - xe_new(e, 1, 1), xe_new(e, 1, 3) - xe_new(e, 1, 1), &
-            xe_new(e, 1, 4) - xe_new(e, 1, 1), xe_new(e, 2, 2) - xe_new(e, 2, 1), &
-            xe_new(e, 2, 3) - xe_new(e, 2, 1), xe_new(e, 2, 4) - xe_new(e, 2, 1), &
-            bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
-            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
-       f_new(e, 1, 1) = f11
-       f_new(e, 2, 1) = f21
-       f_new(e, 1, 2) = f12
-       f_new(e, 2, 2) = f22
-       call plane_rotation(f11, f21, f12, f22, n11, n21, n12, n22)
-       r_new(e, 1, 1) = n11
-       r_new(e, 2, 1) = n21
-       r_new(e, 1, 2) = n12
-       r_new(e, 2, 2) = n22
-       ! strainInc = R_{n+½}ᵀ Δε R_{n+½} (rotate_symmetric_2d with q = R_{n+½}ᵀ: q12 = R21, q21 = R12)
-       call plane_similarity(q11, q21, q12, q22, strain_inc(e, 1), strain_inc(e, 2), strain_inc(e, 4), &
-            strain_inc_corot(e, 1), strain_inc_corot(e, 2), strain_inc_corot(e, 4))
-       strain_inc_corot(e, 3) = strain_inc(e, 3)
-       ! relSpinInc (relative_spin): ΔR = R_{n+1} R_nᵀ
-       rel_spin(e, 1) = plane_relative_spin(spin_inc(e, 1), n11, n21, n12, n22, r_old(e, 1, 1), &
-            r_old(e, 2, 1), r_old(e, 1, 2), r_old(e, 2, 2))
-    end do
-  end subroutine corotational_increment_2d
 
   !> Mean deformation gradient F = Σ_I x_I ⊗ B0_I of a block, B0 the mean gradient of the
   !> reference configuration (fem_cpe4r/fem_c3d8r geometry on x0). Exact for linear fields.

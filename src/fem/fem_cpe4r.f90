@@ -20,7 +20,7 @@ module fem_cpe4r
   implicit none
   private
 
-  public :: cpe4r_geometry, cpe4r_char_length, cpe4r_strain_increment, cpe4r_kinematics
+  public :: cpe4r_geometry, cpe4r_char_length, cpe4r_strain_increment
   public :: cpe4r_internal_force, cpe4r_hourglass_gamma, cpe4r_hourglass, cpe4r_hourglass_update
   public :: cpe4r_increment_kinematics, cpe4r_internal_force_bv
 
@@ -39,29 +39,16 @@ contains
     real(dp), intent(in) :: thickness(nb)
     real(dp), intent(out) :: volume(nb)
     real(dp), intent(out) :: bmat(nb, 2, 4)
-    real(dp) :: dx, dy, ex, ey, area, r2a
+    real(dp) :: area
     integer :: e
 
     ! One loop on scalars. (Whole-block array statements on local copies vectorised, but the
     ! five block-sized automatic arrays are heap-allocated by gfortran: five malloc/free pairs
     ! per call, and five extra passes, cost more than the loop's scalar code.)
     do e = 1, nb
-       dx = xe(e, 1, 3) - xe(e, 1, 1)
-       dy = xe(e, 2, 3) - xe(e, 2, 1)
-       ex = xe(e, 1, 4) - xe(e, 1, 2)
-       ey = xe(e, 2, 4) - xe(e, 2, 2)
-       area = 0.5_dp * (dx * ey - dy * ex)
-       volume(e) = thickness(e) * area
-       ! A degenerate element (A = 0) is caught by the inversion check; avoid 1/0 here.
-       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
-       bmat(e, 1, 1) = -ey * r2a
-       bmat(e, 1, 2) = dy * r2a
-       bmat(e, 1, 3) = ey * r2a
-       bmat(e, 1, 4) = -dy * r2a
-       bmat(e, 2, 1) = ex * r2a
-       bmat(e, 2, 2) = -dx * r2a
-       bmat(e, 2, 3) = -ex * r2a
-       bmat(e, 2, 4) = dx * r2a
+       call quad_geometry(xe(e, 1, 1), xe(e, 1, 2), xe(e, 1, 3), xe(e, 1, 4), xe(e, 2, 1), xe(e, 2, 2), &
+            xe(e, 2, 3), xe(e, 2, 4), thickness(e), area, volume(e), bmat(e, 1, 1), bmat(e, 1, 2), &
+            bmat(e, 1, 3), bmat(e, 1, 4), bmat(e, 2, 1), bmat(e, 2, 2), bmat(e, 2, 3), bmat(e, 2, 4))
     end do
   end subroutine cpe4r_geometry
 
@@ -73,17 +60,14 @@ contains
     integer, intent(in) :: nb
     real(dp), intent(in) :: xe(nb, 2, 4)
     real(dp), intent(out) :: char_length(nb)
-    real(dp) :: area, l2max
+    real(dp) :: area
     integer :: e
 
     do e = 1, nb
        area = 0.5_dp * ((xe(e, 1, 3) - xe(e, 1, 1)) * (xe(e, 2, 4) - xe(e, 2, 2)) &
                         - (xe(e, 2, 3) - xe(e, 2, 1)) * (xe(e, 1, 4) - xe(e, 1, 2)))
-       l2max = max((xe(e, 1, 2) - xe(e, 1, 1))**2 + (xe(e, 2, 2) - xe(e, 2, 1))**2, &
-                   (xe(e, 1, 3) - xe(e, 1, 2))**2 + (xe(e, 2, 3) - xe(e, 2, 2))**2, &
-                   (xe(e, 1, 4) - xe(e, 1, 3))**2 + (xe(e, 2, 4) - xe(e, 2, 3))**2, &
-                   (xe(e, 1, 1) - xe(e, 1, 4))**2 + (xe(e, 2, 1) - xe(e, 2, 4))**2)
-       char_length(e) = abs(area) / sqrt(max(l2max, tiny(1.0_dp)))
+       char_length(e) = quad_char_length(xe(e, 1, 1), xe(e, 1, 2), xe(e, 1, 3), xe(e, 1, 4), xe(e, 2, 1), &
+            xe(e, 2, 2), xe(e, 2, 3), xe(e, 2, 4), area)
     end do
   end subroutine cpe4r_char_length
 
@@ -99,19 +83,13 @@ contains
     real(dp), intent(out) :: strain_inc(nb, 4)
     real(dp), intent(out) :: spin_inc(nb, 1)
     real(dp) :: l11, l12, l21, l22
-    integer :: e, n
+    integer :: e
 
     do e = 1, nb
-       l11 = 0.0_dp
-       l12 = 0.0_dp
-       l21 = 0.0_dp
-       l22 = 0.0_dp
-       do n = 1, 4
-          l11 = l11 + du(e, 1, n) * bmat_mid(e, 1, n)
-          l12 = l12 + du(e, 1, n) * bmat_mid(e, 2, n)
-          l21 = l21 + du(e, 2, n) * bmat_mid(e, 1, n)
-          l22 = l22 + du(e, 2, n) * bmat_mid(e, 2, n)
-       end do
+       call quad_displacement_gradient(du(e, 1, 1), du(e, 1, 2), du(e, 1, 3), du(e, 1, 4), du(e, 2, 1), &
+            du(e, 2, 2), du(e, 2, 3), du(e, 2, 4), bmat_mid(e, 1, 1), bmat_mid(e, 1, 2), bmat_mid(e, 1, 3), &
+            bmat_mid(e, 1, 4), bmat_mid(e, 2, 1), bmat_mid(e, 2, 2), bmat_mid(e, 2, 3), bmat_mid(e, 2, 4), &
+            l11, l12, l21, l22)
        strain_inc(e, 1) = l11
        strain_inc(e, 2) = l22
        strain_inc(e, 3) = 0.0_dp
@@ -120,89 +98,9 @@ contains
     end do
   end subroutine cpe4r_strain_increment
 
-  !> Everything an increment needs from the geometry, in one call:
-  !> mid-increment volume and B (strain, spin, hourglass), end-of-increment volume, B (nodal
-  !> forces) and characteristic length (stable increment).
-  !> One element loop doing the work of cpe4r_geometry (twice), cpe4r_strain_increment and
-  !> cpe4r_char_length with their formulas in their order (bitwise the same results): each
-  !> element's coordinates are read once instead of four passes over the block.
-  pure subroutine cpe4r_kinematics(nb, thickness, xe_mid, du, xe_new, volume_mid, bmat_mid, &
-                                   strain_inc, spin_inc, volume_new, bmat_new, char_length)
-    integer, intent(in) :: nb
-    real(dp), intent(in) :: thickness(nb)
-    real(dp), intent(in) :: xe_mid(nb, 2, 4), du(nb, 2, 4), xe_new(nb, 2, 4)
-    real(dp), intent(out) :: volume_mid(nb), bmat_mid(nb, 2, 4)
-    real(dp), intent(out) :: strain_inc(nb, 4), spin_inc(nb, 1)
-    real(dp), intent(out) :: volume_new(nb), bmat_new(nb, 2, 4), char_length(nb)
-    real(dp) :: dx, dy, ex, ey, area, r2a, l2max
-    real(dp) :: b11, b12, b13, b14, b21, b22, b23, b24, l11, l12, l21, l22
-    integer :: e
-
-    ! ivdep: the dummies do not alias (Fortran), but the compiler's run-time alias checks for
-    ! this many arrays exceed its limit and it left the loop scalar.
-    !GCC$ ivdep
-    do e = 1, nb
-       ! x_{n+½}: volume and B (cpe4r_geometry)
-       dx = xe_mid(e, 1, 3) - xe_mid(e, 1, 1)
-       dy = xe_mid(e, 2, 3) - xe_mid(e, 2, 1)
-       ex = xe_mid(e, 1, 4) - xe_mid(e, 1, 2)
-       ey = xe_mid(e, 2, 4) - xe_mid(e, 2, 2)
-       area = 0.5_dp * (dx * ey - dy * ex)
-       volume_mid(e) = thickness(e) * area
-       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
-       b11 = -ey * r2a
-       b12 = dy * r2a
-       b13 = ey * r2a
-       b14 = -dy * r2a
-       b21 = ex * r2a
-       b22 = -dx * r2a
-       b23 = -ex * r2a
-       b24 = dx * r2a
-       bmat_mid(e, 1, 1) = b11
-       bmat_mid(e, 1, 2) = b12
-       bmat_mid(e, 1, 3) = b13
-       bmat_mid(e, 1, 4) = b14
-       bmat_mid(e, 2, 1) = b21
-       bmat_mid(e, 2, 2) = b22
-       bmat_mid(e, 2, 3) = b23
-       bmat_mid(e, 2, 4) = b24
-       ! strain and spin increments (cpe4r_strain_increment)
-       l11 = (((0.0_dp + du(e, 1, 1) * b11) + du(e, 1, 2) * b12) + du(e, 1, 3) * b13) + du(e, 1, 4) * b14
-       l12 = (((0.0_dp + du(e, 1, 1) * b21) + du(e, 1, 2) * b22) + du(e, 1, 3) * b23) + du(e, 1, 4) * b24
-       l21 = (((0.0_dp + du(e, 2, 1) * b11) + du(e, 2, 2) * b12) + du(e, 2, 3) * b13) + du(e, 2, 4) * b14
-       l22 = (((0.0_dp + du(e, 2, 1) * b21) + du(e, 2, 2) * b22) + du(e, 2, 3) * b23) + du(e, 2, 4) * b24
-       strain_inc(e, 1) = l11
-       strain_inc(e, 2) = l22
-       strain_inc(e, 3) = 0.0_dp
-       strain_inc(e, 4) = 0.5_dp * (l12 + l21)
-       spin_inc(e, 1) = 0.5_dp * (l21 - l12)
-       ! x_{n+1}: volume and B (cpe4r_geometry) and L_e (cpe4r_char_length, whose area is the
-       ! same expression as here)
-       dx = xe_new(e, 1, 3) - xe_new(e, 1, 1)
-       dy = xe_new(e, 2, 3) - xe_new(e, 2, 1)
-       ex = xe_new(e, 1, 4) - xe_new(e, 1, 2)
-       ey = xe_new(e, 2, 4) - xe_new(e, 2, 2)
-       area = 0.5_dp * (dx * ey - dy * ex)
-       volume_new(e) = thickness(e) * area
-       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
-       bmat_new(e, 1, 1) = -ey * r2a
-       bmat_new(e, 1, 2) = dy * r2a
-       bmat_new(e, 1, 3) = ey * r2a
-       bmat_new(e, 1, 4) = -dy * r2a
-       bmat_new(e, 2, 1) = ex * r2a
-       bmat_new(e, 2, 2) = -dx * r2a
-       bmat_new(e, 2, 3) = -ex * r2a
-       bmat_new(e, 2, 4) = dx * r2a
-       l2max = max((xe_new(e, 1, 2) - xe_new(e, 1, 1))**2 + (xe_new(e, 2, 2) - xe_new(e, 2, 1))**2, &
-                   (xe_new(e, 1, 3) - xe_new(e, 1, 2))**2 + (xe_new(e, 2, 3) - xe_new(e, 2, 2))**2, &
-                   (xe_new(e, 1, 4) - xe_new(e, 1, 3))**2 + (xe_new(e, 2, 4) - xe_new(e, 2, 3))**2, &
-                   (xe_new(e, 1, 1) - xe_new(e, 1, 4))**2 + (xe_new(e, 2, 1) - xe_new(e, 2, 4))**2)
-       char_length(e) = abs(area) / sqrt(max(l2max, tiny(1.0_dp)))
-    end do
-  end subroutine cpe4r_kinematics
-
   !> The solver's whole pre-material pass of a CPE4R block in one element loop: the work of
-  !> cpe4r_kinematics, fem_inversion's check_inversion (2D), fem_corotation's
+  !> cpe4r_geometry on x_{n+½} and x_{n+1}, cpe4r_strain_increment, cpe4r_char_length,
+  !> fem_inversion's check_inversion (2D), fem_corotation's
   !> corotational_increment (2D), the current density and the hourglass shape vector γ.
   !> Why one loop: each of those passes streamed the block's coordinates, B matrices and
   !> rotations through the cache again (the block's (nb, 2, 4) arrays do not fit in L1), and
@@ -211,7 +109,7 @@ contains
   !> expression, in the same order, as in those routines, so the results are the same to the bit.
   !> xe_old = x_n, du = Δt v_{n+½} (the gather); x_{n+½} = x_n + ½du, x_{n+1} = x_n + du.
   !> bmat_ref, volume_ref: reference mean gradient and volume; mass: element masses; r_old = R_n.
-  !> Out: as cpe4r_kinematics (volume_mid, strain_inc, volume_new, bmat_new, char_length),
+  !> Out: volume_mid, strain_inc (global), volume_new, bmat_new, char_length,
   !> volume_abs = |volume_mid|, density = mass/|volume_mid|, reason (fem_inversion codes,
   !> check_inversion's order of tests), as corotational_increment r_mid, r_new, f_new,
   !> strain_inc_corot, rel_spin, and for cpe4r_hourglass_update, in place of B_{n+½}: gamma
@@ -232,7 +130,7 @@ contains
     real(dp), intent(out) :: strain_inc_corot(nb, 4), rel_spin(nb, 1)
     ! x_{n+½} (m) and x_{n+1} (n) of the four nodes
     real(dp) :: mx1, mx2, mx3, mx4, my1, my2, my3, my4, nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4
-    real(dp) :: dx, dy, ex, ey, area, r2a, l2max, vol, jmin, hx, hy
+    real(dp) :: area, vol, jmin, hx, hy
     real(dp) :: b11, b12, b13, b14, b21, b22, b23, b24, l11, l12, l21, l22, spin
     real(dp) :: f11, f21, f12, f22, q11, q12, q21, q22, n11, n12, n21, n22
     integer :: e, r
@@ -261,12 +159,8 @@ contains
 
        ! x_{n+½}: volume and B (cpe4r_geometry), density, γ and Σ B² (cpe4r_hourglass_gamma,
        ! cpe4r_hourglass_update)
-       dx = mx3 - mx1
-       dy = my3 - my1
-       ex = mx4 - mx2
-       ey = my4 - my2
-       area = 0.5_dp * (dx * ey - dy * ex)
-       vol = thickness(e) * area
+       call quad_geometry(mx1, mx2, mx3, mx4, my1, my2, my3, my4, thickness(e), area, vol, &
+            b11, b12, b13, b14, b21, b22, b23, b24)
        volume_mid(e) = vol
        volume_abs(e) = abs(vol)
        ! Guarded (the max changes nothing for any valid element): the inversion check now runs
@@ -275,15 +169,6 @@ contains
        density(e) = mass(e) / max(abs(vol), tiny(1.0_dp))
        hx = mx1 - mx2 + mx3 - mx4
        hy = my1 - my2 + my3 - my4
-       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
-       b11 = -ey * r2a
-       b12 = dy * r2a
-       b13 = ey * r2a
-       b14 = -dy * r2a
-       b21 = ex * r2a
-       b22 = -dx * r2a
-       b23 = -ex * r2a
-       b24 = dx * r2a
        gamma(e, 1) = hg_base(1) - hx * b11 - hy * b21
        gamma(e, 2) = hg_base(2) - hx * b12 - hy * b22
        gamma(e, 3) = hg_base(3) - hx * b13 - hy * b23
@@ -291,10 +176,9 @@ contains
        bsq(e) = ((((((((0.0_dp + b11**2) + b21**2) + b12**2) + b22**2) + b13**2) + b23**2) &
             + b14**2) + b24**2)
        ! strain and spin increments (cpe4r_strain_increment)
-       l11 = (((0.0_dp + du(e, 1, 1) * b11) + du(e, 1, 2) * b12) + du(e, 1, 3) * b13) + du(e, 1, 4) * b14
-       l12 = (((0.0_dp + du(e, 1, 1) * b21) + du(e, 1, 2) * b22) + du(e, 1, 3) * b23) + du(e, 1, 4) * b24
-       l21 = (((0.0_dp + du(e, 2, 1) * b11) + du(e, 2, 2) * b12) + du(e, 2, 3) * b13) + du(e, 2, 4) * b14
-       l22 = (((0.0_dp + du(e, 2, 1) * b21) + du(e, 2, 2) * b22) + du(e, 2, 3) * b23) + du(e, 2, 4) * b24
+       call quad_displacement_gradient(du(e, 1, 1), du(e, 1, 2), du(e, 1, 3), du(e, 1, 4), du(e, 2, 1), &
+            du(e, 2, 2), du(e, 2, 3), du(e, 2, 4), b11, b12, b13, b14, b21, b22, b23, b24, &
+            l11, l12, l21, l22)
        strain_inc(e, 1) = l11
        strain_inc(e, 2) = l22
        strain_inc(e, 3) = 0.0_dp
@@ -302,25 +186,11 @@ contains
        spin = 0.5_dp * (l21 - l12)
 
        ! x_{n+1}: volume and B (cpe4r_geometry), L_e (cpe4r_char_length)
-       dx = nx3 - nx1
-       dy = ny3 - ny1
-       ex = nx4 - nx2
-       ey = ny4 - ny2
-       area = 0.5_dp * (dx * ey - dy * ex)
-       vol = thickness(e) * area
+       call quad_geometry(nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4, thickness(e), area, vol, &
+            bmat_new(e, 1, 1), bmat_new(e, 1, 2), bmat_new(e, 1, 3), bmat_new(e, 1, 4), &
+            bmat_new(e, 2, 1), bmat_new(e, 2, 2), bmat_new(e, 2, 3), bmat_new(e, 2, 4))
        volume_new(e) = vol
-       r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
-       bmat_new(e, 1, 1) = -ey * r2a
-       bmat_new(e, 1, 2) = dy * r2a
-       bmat_new(e, 1, 3) = ey * r2a
-       bmat_new(e, 1, 4) = -dy * r2a
-       bmat_new(e, 2, 1) = ex * r2a
-       bmat_new(e, 2, 2) = -dx * r2a
-       bmat_new(e, 2, 3) = -ex * r2a
-       bmat_new(e, 2, 4) = dx * r2a
-       l2max = max((nx2 - nx1)**2 + (ny2 - ny1)**2, (nx3 - nx2)**2 + (ny3 - ny2)**2, &
-                   (nx4 - nx3)**2 + (ny4 - ny3)**2, (nx1 - nx4)**2 + (ny1 - ny4)**2)
-       char_length(e) = abs(area) / sqrt(max(l2max, tiny(1.0_dp)))
+       char_length(e) = quad_char_length(nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4, area)
 
        ! check_inversion_2d on x_{n+1}: corner values ξ_I η_I (x_nξ − x_I) × (x_nη − x_I) in
        ! node order (neighbours 2,4 / 1,3 / 4,2 / 3,1; sign +, −, +, −), their running minimum
@@ -600,4 +470,52 @@ contains
        work(e) = w
     end do
   end subroutine cpe4r_hourglass_update
+  !> Area A, volume t·A and mean gradient B of one element from its node coordinates (the
+  !> formulas of the module header). A degenerate element (A = 0) is caught by the inversion
+  !> check; the guard only avoids 1/0 here.
+  elemental subroutine quad_geometry(x1, x2, x3, x4, y1, y2, y3, y4, thickness, area, volume, &
+                                     b11, b12, b13, b14, b21, b22, b23, b24)
+    real(dp), intent(in) :: x1, x2, x3, x4, y1, y2, y3, y4, thickness
+    real(dp), intent(out) :: area, volume, b11, b12, b13, b14, b21, b22, b23, b24
+    real(dp) :: dx, dy, ex, ey, r2a
+
+    dx = x3 - x1
+    dy = y3 - y1
+    ex = x4 - x2
+    ey = y4 - y2
+    area = 0.5_dp * (dx * ey - dy * ex)
+    volume = thickness * area
+    r2a = 1.0_dp / sign(max(abs(2.0_dp * area), tiny(1.0_dp)), area)
+    b11 = -ey * r2a
+    b12 = dy * r2a
+    b13 = ey * r2a
+    b14 = -dy * r2a
+    b21 = ex * r2a
+    b22 = -dx * r2a
+    b23 = -ex * r2a
+    b24 = dx * r2a
+  end subroutine quad_geometry
+
+  !> L_e = |A| / (longest edge) of one element (cpe4r_char_length).
+  elemental real(dp) function quad_char_length(x1, x2, x3, x4, y1, y2, y3, y4, area) result(char_length)
+    real(dp), intent(in) :: x1, x2, x3, x4, y1, y2, y3, y4, area
+    real(dp) :: l2max
+
+    l2max = max((x2 - x1)**2 + (y2 - y1)**2, (x3 - x2)**2 + (y3 - y2)**2, &
+                (x4 - x3)**2 + (y4 - y3)**2, (x1 - x4)**2 + (y1 - y4)**2)
+    char_length = abs(area) / sqrt(max(l2max, tiny(1.0_dp)))
+  end function quad_char_length
+
+  !> ΔL_ij = Σ_I du_iI B_jI of one element, summed from 0 in node order (cpe4r_strain_increment).
+  elemental subroutine quad_displacement_gradient(u1, u2, u3, u4, v1, v2, v3, v4, b11, b12, b13, b14, &
+                                                  b21, b22, b23, b24, l11, l12, l21, l22)
+    real(dp), intent(in) :: u1, u2, u3, u4, v1, v2, v3, v4
+    real(dp), intent(in) :: b11, b12, b13, b14, b21, b22, b23, b24
+    real(dp), intent(out) :: l11, l12, l21, l22
+
+    l11 = (((0.0_dp + u1 * b11) + u2 * b12) + u3 * b13) + u4 * b14
+    l12 = (((0.0_dp + u1 * b21) + u2 * b22) + u3 * b23) + u4 * b24
+    l21 = (((0.0_dp + v1 * b11) + v2 * b12) + v3 * b13) + v4 * b14
+    l22 = (((0.0_dp + v1 * b21) + v2 * b22) + v3 * b23) + v4 * b24
+  end subroutine quad_displacement_gradient
 end module fem_cpe4r
