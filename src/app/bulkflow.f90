@@ -124,19 +124,13 @@ contains
     error stop 2, quiet=.true.
   end subroutine input_error_exit
 
-  !> A material-point scene (particle decomposition over the ranks, src/mpm/mpm_run.f90); no restart.
+  !> A material-point scene (particle decomposition over the ranks, src/mpm/mpm_run.f90), with
+  !> checkpoints at *RESTART, WRITE and --stop-after, --restart from the last one
+  !> (src/mpm/mpm_checkpoint.f90).
   subroutine run_mpm(m, opts)
     type(model_t), intent(in) :: m
     type(run_options_t), intent(in) :: opts
-    type(error_t) :: e
 
-    e%raised = .false.
-    if (opts%restart .or. any(m%steps(1:m%n_steps)%restart_write)) then
-       e%message = trim(m%input_file) // ': restart is not available for material-point scenes yet; ' // &
-            'expected no --restart and no *RESTART, WRITE'
-       e%raised = .true.
-    end if
-    if (e%raised) call input_error_exit(e)
-    call mpm_run_scene(m, opts%output_base, opts%progress, opts%stop_after, MPI_COMM_WORLD)
+    call mpm_run_scene(m, opts%output_base, opts%progress, opts%stop_after, MPI_COMM_WORLD, opts%restart)
   end subroutine run_mpm
 end program bulkflow

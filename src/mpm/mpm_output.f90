@@ -13,12 +13,17 @@
 !>   BASE.xmf       particles: one Polyvertex grid per frame (temporal collection)
 !>   BASE_grid.xmf  background grid: CoRectMesh with nodal mass and V
 !>
-!> Serial (one rank, as the MPM driver is for now): plain HDF5 calls, no MPI-IO.
+!> Serial (rank 0 writes what it gathered): plain HDF5 calls, no MPI-IO.
+!>
+!> Restart (mpm_checkpoint): mpm_writer_open(..., restart_frames=n) reopens BASE.h5, checks its
+!> grid against the scene's, keeps frames 0..n-1, deletes later ones (written by the
+!> interrupted run after its checkpoint) and rewrites the XDMF files from what it kept.
 module mpm_output
   use, intrinsic :: iso_fortran_env, only: int32
   use hdf5
   use material_kinds, only: dp
-  use error_report, only: raise_error
+  use error_report, only: error_t, raise_error
+  use output_files, only: file_exists, int_to_str
   use mpm_particles, only: particle_block_t
   use mpm_grid, only: grid_t
   implicit none
@@ -34,7 +39,7 @@ module mpm_output
      real(dp), allocatable :: times(:)
   end type mpm_writer_t
 
-  public :: mpm_writer_open, mpm_writer_frame, mpm_writer_close
+  public :: mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
 
 contains
 
@@ -44,13 +49,18 @@ contains
     if (hdferr < 0) call raise_error('', 0, 'HDF5 error while ' // what)
   end subroutine check
 
-  subroutine mpm_writer_open(wr, base, g, ncomp, nsdv)
+  !> Create BASE.h5 (or, with restart_frames, reopen it keeping that many frames; a problem
+  !> then goes to err when given, else stops).
+  subroutine mpm_writer_open(wr, base, g, ncomp, nsdv, restart_frames, err)
     type(mpm_writer_t), intent(out) :: wr
     character(len=*), intent(in) :: base
     type(grid_t), intent(in) :: g
     integer, intent(in) :: ncomp, nsdv
+    integer, intent(in), optional :: restart_frames
+    type(error_t), intent(inout), optional :: err
     integer :: hdferr
     integer(hid_t) :: grp
+    character(len=:), allocatable :: msg
 
     wr%base = base
     wr%h5_name = base // '.h5'
@@ -60,6 +70,16 @@ contains
     allocate (wr%counts(0), wr%times(0))
     call h5open_f(hdferr)
     call check(hdferr, 'opening the HDF5 library')
+    if (present(restart_frames)) then
+       call reopen(wr, g, restart_frames, msg)
+       if (allocated(msg)) then
+          call mpm_writer_close(wr)
+          call raise_error(wr%h5_name, 0, msg, err)
+          return
+       end if
+       call write_xdmf(wr, g)
+       return
+    end if
     call h5fcreate_f(wr%h5_name, H5F_ACC_TRUNC_F, wr%file, hdferr)
     call check(hdferr, 'creating ' // wr%h5_name)
     call write_attr_string(wr%file, 'format', 'bulkflow-mpm')
@@ -160,6 +180,113 @@ contains
     call move_alloc(grown_r, wr%times)
     call write_xdmf(wr, g)
   end subroutine mpm_writer_frame
+
+  !> Frames written so far (what a checkpoint records).
+  pure integer function mpm_writer_frame_count(wr)
+    type(mpm_writer_t), intent(in) :: wr
+    mpm_writer_frame_count = wr%n_frames
+  end function mpm_writer_frame_count
+
+  !> Reopen the file of an interrupted run and keep its first `keep` frames; msg is allocated
+  !> (and the file possibly left open: the caller closes it) when it cannot serve the restart.
+  subroutine reopen(wr, g, keep, msg)
+    type(mpm_writer_t), intent(inout) :: wr
+    type(grid_t), intent(in) :: g
+    integer, intent(in) :: keep
+    character(len=:), allocatable, intent(out) :: msg
+    integer(hid_t) :: parts, grid, frame
+    integer :: hdferr, storage, n_links, max_corder, f, n_found, ndim(1), n(3), count(1)
+    real(dp) :: lo(3), h(1), time(1)
+    character(len=6) :: tag
+    character(len=96) :: text
+    logical :: exists
+
+    if (.not. file_exists(wr%h5_name)) then
+       msg = 'cannot restart: the file does not exist'
+       return
+    end if
+    ! A file that is not HDF5 is reported by us, not by HDF5's error stack on stderr.
+    call h5eset_auto_f(0, hdferr)
+    call h5fopen_f(wr%h5_name, H5F_ACC_RDWR_F, wr%file, hdferr)
+    if (hdferr < 0) then
+       wr%file = -1
+       call h5eset_auto_f(1, hdferr)
+       msg = 'cannot restart: the file cannot be opened as an HDF5 file'
+       return
+    end if
+    call h5lexists_f(wr%file, 'grid', exists, hdferr)
+    if (exists) call h5lexists_f(wr%file, 'particles', exists, hdferr)
+    if (.not. exists .or. hdferr < 0) then
+       call h5eset_auto_f(1, hdferr)
+       msg = 'cannot restart: not the field output of a material-point run (no /grid, /particles)'
+       return
+    end if
+    call h5eset_auto_f(1, hdferr)
+    call h5gopen_f(wr%file, 'grid', grid, hdferr)
+    call check(hdferr, 'opening /grid')
+    call read_attr_int(grid, 'ndim', ndim)
+    call read_attr_int(grid, 'n', n)
+    call read_attr_real(grid, 'lo', lo)
+    call read_attr_real(grid, 'h', h)
+    if (ndim(1) /= g%ndim .or. any(n /= g%n) .or. any(abs(lo - g%lo) > 0) .or. abs(h(1) - g%h) > 0) then
+       write (text, '(i0,a,i0,a,i0,a,es12.5)') n(1), ' x ', n(2), ' x ', n(3), ' nodes, cell ', h(1)
+       msg = 'cannot restart: the file holds a grid of ' // trim(text)
+       write (text, '(i0,a,i0,a,i0,a,es12.5)') g%n(1), ' x ', g%n(2), ' x ', g%n(3), ' nodes, cell ', g%h
+       msg = msg // '; expected the scene''s grid of ' // trim(text)
+       call h5gclose_f(grid, hdferr)
+       return
+    end if
+    call h5gopen_f(wr%file, 'particles', parts, hdferr)
+    call check(hdferr, 'opening /particles')
+    call h5gget_info_f(parts, storage, n_links, max_corder, hdferr)
+    call check(hdferr, 'h5gget_info /particles')
+    n_found = 0
+    do f = 0, n_links - 1
+       write (tag, '(i6.6)') f
+       call h5lexists_f(parts, tag, exists, hdferr)
+       if (.not. exists) exit
+       n_found = n_found + 1
+    end do
+    if (n_found /= n_links) then
+       msg = 'cannot restart: /particles holds ' // int_to_str(n_links) // ' entries but its frames ' // &
+            '000000.. are not numbered consecutively'
+    else if (n_found < keep) then
+       msg = 'cannot restart at frame ' // int_to_str(keep) // ': the file holds only ' // &
+            int_to_str(n_found) // ' frames'
+    end if
+    if (allocated(msg)) then
+       call h5gclose_f(parts, hdferr)
+       call h5gclose_f(grid, hdferr)
+       return
+    end if
+    ! Frames written after the checkpoint by the interrupted run go; the restarted run writes
+    ! them again.
+    do f = keep, n_found - 1
+       write (tag, '(i6.6)') f
+       call h5ldelete_f(parts, tag, hdferr)
+       call check(hdferr, 'deleting frame /particles/' // tag)
+       call h5lexists_f(grid, tag, exists, hdferr)
+       if (exists) call h5ldelete_f(grid, tag, hdferr)
+       call check(hdferr, 'deleting frame /grid/' // tag)
+    end do
+    ! what the XDMF files list: every kept frame's particle count and time
+    deallocate (wr%counts, wr%times)
+    allocate (wr%counts(keep), wr%times(keep))
+    do f = 0, keep - 1
+       write (tag, '(i6.6)') f
+       call h5gopen_f(parts, tag, frame, hdferr)
+       call check(hdferr, 'opening frame /particles/' // tag)
+       call read_attr_int(frame, 'count', count)
+       call read_attr_real(frame, 'total_time', time)
+       call h5gclose_f(frame, hdferr)
+       wr%counts(f + 1) = count(1)
+       wr%times(f + 1) = time(1)
+    end do
+    wr%n_frames = keep
+    call h5gclose_f(parts, hdferr)
+    call h5gclose_f(grid, hdferr)
+    call h5fflush_f(wr%file, H5F_SCOPE_GLOBAL_F, hdferr)
+  end subroutine reopen
 
   subroutine mpm_writer_close(wr)
     type(mpm_writer_t), intent(inout) :: wr
@@ -313,6 +440,38 @@ contains
     call h5aclose_f(attr, hdferr)
     call h5sclose_f(space, hdferr)
   end subroutine write_attr_int
+
+  subroutine read_attr_int(loc, name, v)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: v(:)
+    integer(hsize_t) :: dims(1)
+    integer(hid_t) :: attr
+    integer :: hdferr
+    dims = size(v)
+    v = 0
+    call h5aopen_f(loc, name, attr, hdferr)
+    call check(hdferr, 'opening attribute ' // name)
+    call h5aread_f(attr, H5T_NATIVE_INTEGER, v, dims, hdferr)
+    call check(hdferr, 'reading attribute ' // name)
+    call h5aclose_f(attr, hdferr)
+  end subroutine read_attr_int
+
+  subroutine read_attr_real(loc, name, v)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(out) :: v(:)
+    integer(hsize_t) :: dims(1)
+    integer(hid_t) :: attr
+    integer :: hdferr
+    dims = size(v)
+    v = 0
+    call h5aopen_f(loc, name, attr, hdferr)
+    call check(hdferr, 'opening attribute ' // name)
+    call h5aread_f(attr, H5T_NATIVE_DOUBLE, v, dims, hdferr)
+    call check(hdferr, 'reading attribute ' // name)
+    call h5aclose_f(attr, hdferr)
+  end subroutine read_attr_real
 
   subroutine write_attr_real(loc, name, v)
     integer(hid_t), intent(in) :: loc

@@ -21,13 +21,15 @@
 !> update and the walls itself; particles never migrate. Inflow particles are made by rank 0.
 !> Sums over ranks are in rank order (MPI_Allreduce): results are deterministic for a given
 !> number of ranks and differ from 1 rank by round-off only. Output: rank 0 gathers the blocks.
+!> Checkpoint and restart: src/mpm/mpm_checkpoint.f90 (the hooks at the end of this module copy
+!> the run state in and out).
 module mpm_run
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_IN_PLACE, &
        MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_INTEGER8, MPI_LOGICAL, MPI_SUM, MPI_MAX, MPI_LOR, MPI_MAXLOC, &
        MPI_2DOUBLE_PRECISION, MPI_Send, MPI_Recv, MPI_STATUS_IGNORE
   use material_kinds, only: dp
-  use error_report, only: raise_error
+  use error_report, only: error_t, raise_error
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
   use mpm_scene, only: mpm_scene_t, particle_region_t, mpm_inflow_t, region_box, region_polygon
@@ -37,12 +39,14 @@ module mpm_run
   use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance, &
        wall_slide_velocity
   use mpm_mirror, only: mirror_plane_t, mirror_plane_setup, mirror_fold, mirror_fold_momentum
-  use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close
+  use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
+  use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, &
+       mpm_restart_outputs, mpm_restart_stop
   use driver_vumat_call, only: vumat_work_t, vumat_work_init, call_material, packaging_modulus
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
   use output_timer, only: timer_set_t, timer_init, timer_register, timer_start, timer_stop, timer_report
-  use output_history, only: history_t, history_open, history_row, history_close
+  use output_history, only: history_t, history_open, history_row, history_close, history_row_count
   implicit none
   private
 
@@ -105,13 +109,15 @@ module mpm_run
 
 contains
 
-  !> Run a material-point scene: base = output path without extension.
-  subroutine mpm_run_scene(m, base, progress, stop_after, comm)
+  !> Run a material-point scene: base = output path without extension. stop_after > 0: stop
+  !> (with a checkpoint) after that increment; restart: continue from the checkpoint of base.
+  subroutine mpm_run_scene(m, base, progress, stop_after, comm, restart)
     type(model_t), intent(in) :: m
     character(len=*), intent(in) :: base
     logical, intent(in) :: progress
     integer, intent(in) :: stop_after
     type(MPI_Comm), intent(in) :: comm
+    logical, intent(in), optional :: restart
     type(mpm_state_t) :: st
     type(mpm_effects_t) :: fx
     type(mpm_writer_t) :: wr
@@ -119,9 +125,9 @@ contains
     character(len=32), allocatable :: columns(:)
     real(dp) :: next_field, next_history, field_dt, history_dt, last_row_time, last_row_out
     real(dp) :: period, eps
-    integer :: s, k, nsdv
+    integer :: s, k, nsdv, first_step
     integer(int64) :: clock_last, clock_now, clock_rate, clock_start
-    logical :: stop_now
+    logical :: stop_now, resumed, history_due, field_due
 
     st%comm = comm
     call MPI_Comm_rank(comm, st%rank)
@@ -132,25 +138,39 @@ contains
        nsdv = max(nsdv, m%materials(k)%nstatev)
     end do
     if (st%rank == 0) call header(m, st, fx, base)
-    if (st%rank == 0) call mpm_writer_open(wr, base, st%g, st%nc, nsdv)
     call history_columns(m, columns)
-    call history_open(hist, base // '_history.csv', columns, comm)
-    call measure(st)
-    call write_frame(st, wr, 1, 0.0_dp)
-    last_row_time = 0
-    last_row_out = 0
-    call write_history(m, st, hist, last_row_time, last_row_out)
+    resumed = .false.
+    if (present(restart)) resumed = restart
+    first_step = 1
+    if (resumed) then
+       call resume(m, st, base, nsdv, columns, wr, hist, next_field, next_history, last_row_time, last_row_out)
+       first_step = st%step
+    else
+       if (st%rank == 0) call mpm_writer_open(wr, base, st%g, st%nc, nsdv)
+       call history_open(hist, base // '_history.csv', columns, comm)
+       call measure(st)
+       call write_frame(st, wr, 1, 0.0_dp)
+       last_row_time = 0
+       last_row_out = 0
+       call write_history(m, st, hist, last_row_time, last_row_out)
+    end if
     call system_clock(clock_last, clock_rate)
     clock_start = clock_last
     stop_now = .false.
-    do s = 1, m%n_steps
-       st%step = s
-       st%step_time = 0
+    do s = first_step, m%n_steps
+       ! a resumed step continues at the checkpoint's step time and output schedule
+       if (.not. resumed) then
+          st%step = s
+          st%step_time = 0
+       end if
        period = m%steps(s)%period
        eps = 1.0e-12_dp * period
        call output_intervals(m, s, field_dt, history_dt)
-       next_field = field_dt
-       next_history = history_dt
+       if (.not. resumed) then
+          next_field = field_dt
+          next_history = history_dt
+       end if
+       resumed = .false.
        call mark_wall_nodes(m, st)
        do while (st%step_time < period - eps)
           call stable_increment(m, st)
@@ -163,20 +183,31 @@ contains
           st%increment = st%increment + 1
           stop_now = stop_after > 0 .and. st%increment >= stop_after
           call timer_start(fx%timers, fx%id(fx_output))
-          if (st%step_time >= next_history - eps .or. st%step_time >= period - eps .or. stop_now) then
+          history_due = st%step_time >= next_history - eps .or. st%step_time >= period - eps
+          field_due = st%step_time >= next_field - eps .or. (st%step_time >= period - eps .and. field_dt < huge(1.0_dp))
+          if (history_due) then
              call measure(st)
              call write_history(m, st, hist, last_row_time, last_row_out)
              do while (next_history <= st%step_time + eps)
                 next_history = next_history + history_dt
              end do
           end if
-          if (st%step_time >= next_field - eps .or. (st%step_time >= period - eps .and. field_dt < huge(1.0_dp)) &
-               .or. stop_now) then
+          if (field_due) then
              call write_frame(st, wr, s, st%step_time)
              do while (next_field <= st%step_time + eps)
                 next_field = next_field + field_dt
              end do
           end if
+          ! The checkpoint (timed as output) follows the increment's own output and precedes the
+          ! extra row and frame of a stop: the uninterrupted run has none there, so a restart
+          ! drops them (it keeps the frames and rows the checkpoint counted).
+          if (stop_now .or. mpm_checkpoint_due(m, s, st%step_time, st%dt)) &
+               call save_checkpoint(m, st, base, wr, hist, next_field, next_history, last_row_time, last_row_out)
+          if (stop_now .and. .not. history_due) then
+             call measure(st)
+             call write_history(m, st, hist, last_row_time, last_row_out)
+          end if
+          if (stop_now .and. .not. field_due) call write_frame(st, wr, s, st%step_time)
           if (progress .and. st%rank == 0) then
              ! rank 0's own clock decides: no collective here (the ranks' clocks differ)
              call system_clock(clock_now)
@@ -1361,7 +1392,8 @@ contains
     call sum_real(st, g)
     call timer_report(fx%timers, output_unit, st%comm)
     if (st%rank /= 0) return
-    if (stopped) write (output_unit, '(a,i0)') 'bulkflow: stopped after increment ', st%increment
+    if (stopped) write (output_unit, '(a,i0,a)') 'bulkflow: stopped after increment ', st%increment, &
+         ' as asked (--stop-after); continue with --restart'
     write (output_unit, '(a,i0,a,es12.5)') 'bulkflow: done, ', st%increment, ' increments, t = ', st%total_time
     write (output_unit, '(a,i0,a,i0,a,i0,a)') '  particles ', nint(g(2)), ' (', st%n_in, ' in, ', nint(g(4)), ' out)'
     write (output_unit, '(a,4es14.6,a,es10.2)') '  mass      initial, in, out, now:', st%mass_initial, st%mass_in, &
@@ -1377,4 +1409,111 @@ contains
          ' particle-steps, ', rate, ' per second (time loop ', st%loop_seconds, ' s, ', st%nranks, &
          ' ranks: ', rate / st%nranks, ' per rank)'
   end subroutine summary
+
+  ! ------------------------------------------------------------------------------ checkpoint hooks
+
+  !> Write a checkpoint of the run (mpm_checkpoint; collective). The loop's own variables (the
+  !> step's output schedule, the MDR reference of the last history row) go with the state.
+  subroutine save_checkpoint(m, st, base, wr, hist, next_field, next_history, last_row_time, last_row_out)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(in) :: st
+    character(len=*), intent(in) :: base
+    type(mpm_writer_t), intent(in) :: wr
+    type(history_t), intent(in) :: hist
+    real(dp), intent(in) :: next_field, next_history, last_row_time, last_row_out
+    type(mpm_saved_t) :: sv
+
+    sv%step = st%step
+    sv%increment = st%increment
+    sv%step_time = st%step_time
+    sv%total_time = st%total_time
+    sv%dt = st%dt
+    sv%dt_stable = st%dt_stable
+    sv%next_number = st%next_number
+    sv%n_initial = st%n_initial
+    sv%n_in = st%n_in
+    sv%n_out = st%n_out
+    sv%n_guarded = st%n_guarded
+    sv%mass_initial = st%mass_initial
+    sv%mass_in = st%mass_in
+    sv%mass_out = st%mass_out
+    sv%mass_cutoff = st%mass_cutoff
+    sv%e_kinetic = st%e_kinetic
+    sv%e_internal = st%e_internal
+    sv%w_external = st%w_external
+    sv%e_walls = st%e_walls
+    sv%e_damping = st%e_damping
+    sv%e_out = st%e_out
+    sv%e_in = st%e_in
+    sv%gravity = st%gravity
+    sv%impulse_time = st%impulse_time
+    sv%wall_force = st%wall_force
+    sv%wall_impulse = st%wall_impulse
+    sv%wall_force_row = st%wall_force_row
+    sv%next_field = next_field
+    sv%next_history = next_history
+    sv%last_row_time = last_row_time
+    sv%last_row_out = last_row_out
+    sv%frames = 0
+    if (st%rank == 0) sv%frames = mpm_writer_frame_count(wr)
+    sv%rows = history_row_count(hist)
+    call mpm_checkpoint_save(base, st%comm, m, st%blocks, st%nblocks, sv)
+  end subroutine save_checkpoint
+
+  !> Continue from the checkpoint of base: the set-up's particles are replaced by the
+  !> checkpoint's, the outputs are reopened at it. A restart that cannot continue stops here on
+  !> every rank with the reason (mpm_restart_stop). particle_steps is not restored: the
+  !> throughput report is this run's.
+  subroutine resume(m, st, base, nsdv, columns, wr, hist, next_field, next_history, last_row_time, last_row_out)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    character(len=*), intent(in) :: base
+    integer, intent(in) :: nsdv
+    character(len=*), intent(in) :: columns(:)
+    type(mpm_writer_t), intent(inout) :: wr
+    type(history_t), intent(inout) :: hist
+    real(dp), intent(out) :: next_field, next_history, last_row_time, last_row_out
+    type(mpm_saved_t) :: sv
+    type(error_t) :: err
+
+    call mpm_checkpoint_load(base, st%comm, m, st%nd, st%nc, st%ns, st%blocks, st%nblocks, sv, err)
+    if (.not. err%raised) call mpm_restart_outputs(base, st%comm, st%g, st%nc, nsdv, columns, sv%frames, &
+         sv%rows, wr, hist, err)
+    if (err%raised) call mpm_restart_stop(st%comm, err)
+    st%step = sv%step
+    st%increment = sv%increment
+    st%step_time = sv%step_time
+    st%total_time = sv%total_time
+    st%dt = sv%dt
+    st%dt_stable = sv%dt_stable
+    st%next_number = sv%next_number
+    st%n_initial = sv%n_initial
+    st%n_in = sv%n_in
+    st%n_out = sv%n_out
+    st%n_guarded = sv%n_guarded
+    st%mass_initial = sv%mass_initial
+    st%mass_in = sv%mass_in
+    st%mass_out = sv%mass_out
+    st%mass_cutoff = sv%mass_cutoff
+    st%e_kinetic = sv%e_kinetic
+    st%e_internal = sv%e_internal
+    st%w_external = sv%w_external
+    st%e_walls = sv%e_walls
+    st%e_damping = sv%e_damping
+    st%e_out = sv%e_out
+    st%e_in = sv%e_in
+    st%gravity = sv%gravity
+    st%impulse_time = sv%impulse_time
+    st%wall_force = sv%wall_force
+    st%wall_impulse = sv%wall_impulse
+    st%wall_force_row = sv%wall_force_row
+    next_field = sv%next_field
+    next_history = sv%next_history
+    last_row_time = sv%last_row_time
+    last_row_out = sv%last_row_out
+    if (st%rank == 0) then
+       write (output_unit, '(a,i0,a,es12.5)') '  restart   from increment ', st%increment, ' at t = ', st%total_time
+       flush (output_unit)
+    end if
+  end subroutine resume
 end module mpm_run

@@ -19,6 +19,13 @@ kinds:
              no particle is put back onto the plane (GUARDED = 0): src/mpm/mpm_mirror.f90
   mass       hopper with outlet, outflow and inflow: initial + in - out = in domain exactly
              (particle counts exact, masses to round-off), and both flows present
+  restart    on --ranks N: a run uninterrupted, one stopped with --stop-after K (in the
+             discharge, after outflow and inflow began) and continued with --restart: every
+             particle and grid frame (datasets and attributes), the XDMF files and the history
+             CSV identical bit for bit; the *RESTART checkpoint left by the full run is at its
+             last increment and a --restart from it changes nothing; refused restarts (no
+             checkpoint, a changed scene, another number of ranks) exit with status 2 and a
+             `file: ...; expected ...` message, no backtrace, no MPI_Abort
 Every kind also checks the effects line and the timing table (MPM effects with shares).
 Figures are printed so the test log holds them.
 """
@@ -247,10 +254,172 @@ def mpi(args):
     check(n_frame == int(b["particles"][-1]), f"last frame holds all {n_frame} particles (gathered on rank 0)")
 
 
+def mpi_env():
+    import os
+    return dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                OMPI_MCA_rmaps_base_oversubscribe="1")
+
+
+def launch(args, scene, base, ranks, extra=()):
+    """bulkflow on `ranks` ranks (1: without mpiexec); returns the CompletedProcess."""
+    cmd = [args.bulkflow, str(scene), "--output", str(base), "--quiet", *extra]
+    if ranks > 1:
+        cmd = [args.mpiexec, "-np", str(ranks)] + cmd
+    return subprocess.run(cmd, capture_output=True, text=True, env=mpi_env())
+
+
+def checkpoint_header(path):
+    """The header of a checkpoint file (output_checkpoint.f90): ranks, rank, step, increment, times."""
+    import struct
+    raw = Path(path).read_bytes()[:8 + 5 * 4 + 3 * 8 + 2 * 4]
+    magic = raw[:8]
+    version, nranks, rank, step, inc = struct.unpack("<5i", raw[8:28])
+    step_time, total_time, dt = struct.unpack("<3d", raw[28:52])
+    frames, rows = struct.unpack("<2i", raw[52:60])
+    return dict(magic=magic, nranks=nranks, rank=rank, step=step, increment=inc, step_time=step_time,
+                total_time=total_time, frames=frames, rows=rows)
+
+
+def h5_items(path):
+    """{name: (array or None for a group, {attribute: array})} of every object in the file."""
+    items = {}
+    with h5py.File(str(path), "r") as f:
+        def visit(name, obj):
+            data = obj[()] if isinstance(obj, h5py.Dataset) else None
+            items[name] = (data, {k: np.asarray(v) for k, v in obj.attrs.items()})
+        f.visititems(visit)
+    return items
+
+
+def same_h5(a, b):
+    """Names of the objects (datasets, attributes) that differ between two HDF5 files."""
+    ia, ib = h5_items(a), h5_items(b)
+    bad = sorted(set(ia) ^ set(ib))
+    for name in sorted(set(ia) & set(ib)):
+        (da, aa), (db, ab) = ia[name], ib[name]
+        if (da is None) != (db is None) or (da is not None and (da.dtype != db.dtype or da.shape != db.shape
+                                                                or da.tobytes() != db.tobytes())):
+            bad.append(name)
+        if set(aa) != set(ab) or any(aa[k].tobytes() != ab[k].tobytes() for k in aa):
+            bad.append(name + " (attributes)")
+    return bad, len(ia)
+
+
+def compare_runs(ref, other, what):
+    bad, n = same_h5(str(ref) + ".h5", str(other) + ".h5")
+    frames = len([k for k in h5_items(str(ref) + ".h5") if k.count("/") == 1 and k.startswith("particles/")])
+    check(not bad, f"{what}: {frames} particle frames + grid frames, {n} HDF5 objects identical bit for bit"
+          + (f" (differ: {', '.join(bad[:6])})" if bad else ""))
+    for suffix in (".xmf", "_grid.xmf", "_history.csv"):
+        ta, tb = Path(str(ref) + suffix).read_text(), Path(str(other) + suffix).read_text()
+        # the XDMF files name their HDF5 file
+        tb = tb.replace(Path(other).name + ".h5:", Path(ref).name + ".h5:")
+        if suffix == "_history.csv" and ta != tb:
+            ra, rb = ta.splitlines(), tb.splitlines()
+            row = next((i for i, (x, y) in enumerate(zip(ra, rb)) if x != y), min(len(ra), len(rb)))
+            print(f"      first difference in line {row + 1}: {len(ra)} vs {len(rb)} lines")
+        check(ta == tb, f"{what}: {Path(str(ref) + suffix).name[len(Path(str(ref)).name):]} identical"
+              + (f" ({len(ta.splitlines()) - 1} rows)" if suffix == "_history.csv" else ""))
+
+
+def refused(r, what, needles):
+    """A restart that must be refused: status 2, the reason, no backtrace, no MPI_Abort."""
+    text = r.stdout + r.stderr
+    msg = next((l for l in r.stderr.splitlines() if l.startswith("bulkflow: error:")), "")
+    print(f"      {what}: exit {r.returncode}: {msg}")
+    check(r.returncode == 2, f"{what}: refused with exit status 2")
+    check(all(n in msg for n in needles) and "expected" in msg,
+          f"{what}: the message names the file and the problem and says what was expected")
+    check(r.stderr.count("bulkflow: error:") == 1, f"{what}: said once (rank 0)")
+    check("Backtrace" not in text and "MPI_ABORT" not in text and "Error termination" not in text,
+          f"{what}: no backtrace, no MPI_Abort")
+
+
+def restart(args):
+    import shutil
+    n, k = args.ranks, args.stop_after
+    wd = args.workdir
+    if wd.exists():
+        shutil.rmtree(wd)
+    wd.mkdir(parents=True)
+    scene = Path(args.scene).resolve()
+    print(f"{scene.name}: restart after increment {k} on {n} rank(s)")
+
+    full = wd / "full"
+    r = launch(args, scene, full, n)
+    sys.stdout.write(r.stdout)
+    sys.stderr.write(r.stderr)
+    check(r.returncode == 0, f"uninterrupted run on {n} rank(s): exit status {r.returncode}")
+    hist = np.genfromtxt(str(full) + "_history.csv", delimiter=",", names=True)
+    last_inc = int(hist["increment"][-1])
+    # The scene's last step writes a checkpoint every TIME INTERVAL (not at its end): the full
+    # run leaves the one of the last multiple, as a run killed after it would.
+    restart_lines = [l for l in scene.read_text().splitlines() if l.upper().startswith("*RESTART")]
+    interval = float(restart_lines[-1].upper().split("TIME INTERVAL=")[1].split(",")[0])
+    period = float(hist["step_time"][-1])
+    mark = interval * math.floor(period / interval + 1e-9)
+    hdr = [checkpoint_header(f"{full}.rst.{rank}") for rank in range(n)]
+    check(all(h["magic"] == b"BFLOWRST" and h["nranks"] == n and h["step"] == int(hist["step"][-1])
+              and 0 <= h["step_time"] - mark < 1e-3 and h["increment"] == hdr[0]["increment"] < last_inc
+              for h in hdr),
+          f"*RESTART, WRITE, TIME INTERVAL={interval:g} left a checkpoint per rank at step time "
+          f"{hdr[0]['step_time']:.5f} (increment {hdr[0]['increment']} of {last_inc})")
+
+    stopped = wd / "restarted"
+    r = launch(args, scene, stopped, n, ["--stop-after", str(k)])
+    check(r.returncode == 0 and f"stopped after increment {k}" in r.stdout,
+          f"interrupted run stopped after increment {k}")
+    h = checkpoint_header(f"{stopped}.rst.0")
+    part = np.genfromtxt(str(stopped) + "_history.csv", delimiter=",", names=True)
+    check(h["increment"] == k and h["step"] == 2, f"its checkpoint is at increment {k} in step {h['step']}")
+    check(part["MASS_OUT"][-1] > 0 and part["MASS_IN"][-1] > 0,
+          f"outflow ({part['MASS_OUT'][-1]:.4g} kg) and inflow ({part['MASS_IN'][-1]:.4g} kg) before the stop")
+    saved = wd / "saved"
+    for rank in range(n):
+        shutil.copy(f"{stopped}.rst.{rank}", f"{saved}.rst.{rank}")
+    for suffix in (".h5", "_history.csv"):
+        shutil.copy(str(stopped) + suffix, str(saved) + suffix)
+
+    r = launch(args, scene, stopped, n, ["--restart"])
+    sys.stdout.write(r.stdout)
+    sys.stderr.write(r.stderr)
+    check(r.returncode == 0 and f"restart   from increment {k}" in r.stdout,
+          f"--restart continued from increment {k}: exit status {r.returncode}")
+    compare_runs(full, stopped, "stopped + restarted vs uninterrupted")
+
+    # A run killed after its last *RESTART checkpoint: its outputs hold frames and rows written
+    # after it; the restart drops them and writes them again.
+    crash = wd / "crashed"
+    for suffix in [f".rst.{rank}" for rank in range(n)] + [".h5", "_history.csv"]:
+        shutil.copy(str(full) + suffix, str(crash) + suffix)
+    r = launch(args, scene, crash, n, ["--restart"])
+    check(r.returncode == 0, f"--restart from the *RESTART checkpoint (outputs run past it): exit status {r.returncode}")
+    compare_runs(full, crash, "restart from the *RESTART checkpoint vs uninterrupted")
+
+    # Refused restarts.
+    refused(launch(args, scene, wd / "none", n, ["--restart"]), "no checkpoint",
+            [f"none.rst.0: cannot open the file"])
+    changed = wd / "changed.inp"
+    text = scene.read_text()
+    check("*MPM CONTROLS, DAMPING=0." in text, "the scene has the discharge's damping to change")
+    changed.write_text(text.replace("*MPM CONTROLS, DAMPING=0.", "*MPM CONTROLS, DAMPING=0.05"))
+    for suffix in [f".rst.{rank}" for rank in range(n)] + [".h5", "_history.csv"]:
+        shutil.copy(str(saved) + suffix, str(wd / "changed") + suffix)
+    refused(launch(args, changed, wd / "changed", n, ["--restart"]), "changed scene",
+            ["changed.rst.0: the scene is not the one", "*MPM CONTROLS, DAMPING of step 2"])
+    check(Path(str(wd / "changed") + "_history.csv").read_text() == Path(str(saved) + "_history.csv").read_text(),
+          "changed scene: the outputs of the interrupted run are left untouched")
+    other = 2 if n == 1 else 1
+    refused(launch(args, scene, saved, other, ["--restart"]), f"restart on {other} rank(s) of a {n}-rank checkpoint",
+            [f"saved.rst.", f"written by a run on {n} ranks, this run has {other}"])
+
+
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("kind", choices=["column", "incline", "heap", "mirror", "mass", "mpi"])
+    p.add_argument("kind", choices=["column", "incline", "heap", "mirror", "mass", "mpi", "restart"])
     p.add_argument("--mpiexec", default="mpirun")
+    p.add_argument("--ranks", type=int, default=1, help="restart: number of ranks")
+    p.add_argument("--stop-after", type=int, default=0, help="restart: increment to stop after")
     p.add_argument("scene")
     p.add_argument("--bulkflow", required=True)
     p.add_argument("--workdir", required=True, type=Path)

@@ -1,0 +1,764 @@
+!> Checkpoint and restart of a material-point run (the time loop is src/mpm/mpm_run.f90).
+!>
+!> Owns what a checkpoint of an MPM run holds and how a restart checks and restores it:
+!>   * this rank's particle blocks; their number and sizes change with outflow and inflow, so
+!>     the block table (count, material, state and field columns, half-length) comes first,
+!>     then one flat array per particle field holding every block's values in block order.
+!>     Flat arrays, not one record per block: reading is collective record by record
+!>     (output_checkpoint agrees on errors), and the ranks hold different numbers of blocks;
+!>   * the run's counters and sums (mpm_saved_t): time, step, increment, Δt, particle
+!>     numbering, mass and particle counts in/out, energies, wall impulses and forces, the
+!>     step's output schedule, the MDR reference of the last history row, and the number of
+!>     field frames and history rows written so far;
+!>   * a fingerprint of the scene (grid, materials, regions, walls, steps, amplitudes), so that
+!>     a restart of a changed scene is refused with the item that changed.
+!> Everything else (grid, wall node lists, mirror planes, material moduli) is rebuilt by the
+!> set-up from the scene, and the grid carries no history (mpm_grid), so a restarted run
+!> repeats the uninterrupted one bit for bit.
+!>
+!> Files: one per rank, `<base>.rst.<rank>`, in the element driver's format (output_checkpoint:
+!> atomic replacement, rank count, names, kinds and shapes checked), so a restart needs the
+!> number of ranks that wrote the checkpoint; another number is refused. On restart BASE.h5
+!> keeps the frames and BASE_history.csv the rows the checkpoint counted; what the interrupted
+!> run wrote after its checkpoint is replaced.
+!>
+!> Every failure of a restart (no checkpoint, another rank count, a changed scene, outputs that
+!> do not match) is agreed between the ranks and ends the run cleanly: rank 0 prints
+!> `bulkflow: error: file: what is wrong; expected ...`, exit status 2, no MPI_Abort.
+module mpm_checkpoint
+  use, intrinsic :: iso_fortran_env, only: error_unit, int64
+  use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Bcast, MPI_INTEGER, MPI_Finalize
+  use material_kinds, only: dp
+  use error_report, only: error_t, raise_error
+  use model, only: model_t
+  use mpm_particles, only: particle_block_t, particle_block_size, block_allocate
+  use mpm_grid, only: grid_t
+  use mpm_output, only: mpm_writer_t, mpm_writer_open
+  use output_checkpoint, only: checkpoint_t, checkpoint_header_t, checkpoint_begin_write, checkpoint_put, &
+       checkpoint_end_write, checkpoint_begin_read, checkpoint_get, checkpoint_end_read, checkpoint_file_name
+  use output_collective, only: agree_on_error
+  use output_history, only: history_t, history_open
+  use output_files, only: int_to_str
+  implicit none
+  private
+
+  !> The run state a checkpoint holds besides the particle blocks; mpm_run copies its own
+  !> state in and out (values marked "rank" in mpm_run are this rank's part).
+  type, public :: mpm_saved_t
+     integer :: step = 0, increment = 0
+     real(dp) :: step_time = 0, total_time = 0, dt = 0, dt_stable = 0
+     integer :: next_number = 0                       !< last particle number given
+     integer :: n_initial = 0, n_in = 0, n_out = 0, n_guarded = 0
+     real(dp) :: mass_initial = 0, mass_in = 0, mass_out = 0, mass_cutoff = 0
+     real(dp) :: e_kinetic = 0, e_internal = 0, w_external = 0, e_walls = 0, e_damping = 0
+     real(dp) :: e_out = 0, e_in = 0
+     real(dp) :: gravity(3) = 0
+     real(dp) :: impulse_time = 0                     !< time the wall impulses were summed over
+     real(dp), allocatable :: wall_force(:, :)        !< (3, n_walls)
+     real(dp), allocatable :: wall_impulse(:, :)      !< (3, n_walls) since the last history row
+     real(dp), allocatable :: wall_force_row(:, :)    !< (3, n_walls) of the last history row
+     real(dp) :: next_field = 0, next_history = 0     !< the step's output schedule
+     real(dp) :: last_row_time = 0, last_row_out = 0  !< time and MASS_OUT of the last row (MDR)
+     integer :: frames = 0                            !< field frames written (rank 0's writer)
+     integer :: rows = 0                              !< history rows written
+  end type mpm_saved_t
+
+  public :: mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
+  public :: mpm_restart_stop
+
+  integer, parameter :: n_scalars = 20
+  integer, parameter :: n_counters = 6
+  integer, parameter :: item_length = 96
+  !> The per-particle real arrays of a block that a checkpoint holds (the stencil arrays node,
+  !> w, dw are recomputed at the start of every increment).
+  character(len=13), parameter :: block_fields(13) = [character(len=13) :: 'x', 'v', 'mass', 'vol0', 'f', &
+       'rot', 'stress', 'stress_global', 'state', 'field', 'e_int', 'e_inel', 'log_strain']
+
+contains
+
+  !> Is a checkpoint due after this increment (*RESTART, WRITE of the step)? The element
+  !> driver's rule: at every multiple of the interval the increment reached or crossed.
+  logical function mpm_checkpoint_due(m, step, step_time, dt) result(due)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: step
+    real(dp), intent(in) :: step_time, dt
+    real(dp) :: interval, before
+
+    due = .false.
+    if (.not. m%steps(step)%restart_write) return
+    interval = m%steps(step)%restart_interval
+    if (interval <= 0) then
+       due = step_time >= m%steps(step)%period * (1 - 1.0e-12_dp)
+       return
+    end if
+    before = step_time - dt
+    due = floor(step_time / interval + 1.0e-9_dp) > floor(before / interval + 1.0e-9_dp)
+  end function mpm_checkpoint_due
+
+  ! ------------------------------------------------------------------------------ writing
+
+  !> Write this rank's checkpoint (collective: every rank writes its file, then all replace the
+  !> previous checkpoint together). `sv%frames` is read on rank 0, whose writer counts them.
+  subroutine mpm_checkpoint_save(base, comm, m, blocks, nblocks, sv)
+    character(len=*), intent(in) :: base
+    type(MPI_Comm), intent(in) :: comm
+    type(model_t), intent(in) :: m
+    type(particle_block_t), intent(in) :: blocks(:)
+    integer, intent(in) :: nblocks
+    type(mpm_saved_t), intent(in) :: sv
+    type(checkpoint_t) :: ck
+    type(checkpoint_header_t) :: header
+    real(dp), allocatable :: scene(:)
+    character(len=item_length), allocatable :: names(:)
+    integer :: frames(1), ib, j, info(4, nblocks)
+    real(dp), allocatable :: flat(:)
+
+    frames(1) = sv%frames
+    call MPI_Bcast(frames, 1, MPI_INTEGER, 0, comm)
+    header%step = sv%step
+    header%increment = sv%increment
+    header%step_time = sv%step_time
+    header%total_time = sv%total_time
+    header%dt = sv%dt
+    header%frame_count = frames(1)
+    header%history_rows = sv%rows
+    call checkpoint_begin_write(ck, base, comm, header)
+    call scene_fingerprint(m, scene, names)
+    call checkpoint_put(ck, 'scene_items', size(scene))
+    call checkpoint_put(ck, 'scene', scene)
+    call checkpoint_put(ck, 'counters', [sv%next_number, sv%n_initial, sv%n_in, sv%n_out, sv%n_guarded, nblocks])
+    call checkpoint_put(ck, 'scalars', pack_scalars(sv))
+    call checkpoint_put(ck, 'wall_force', sv%wall_force)
+    call checkpoint_put(ck, 'wall_impulse', sv%wall_impulse)
+    call checkpoint_put(ck, 'wall_force_row', sv%wall_force_row)
+    do ib = 1, nblocks
+       info(:, ib) = [blocks(ib)%count, blocks(ib)%material, size(blocks(ib)%state, 2), size(blocks(ib)%field, 2)]
+    end do
+    call checkpoint_put(ck, 'block_info', info)
+    call checkpoint_put(ck, 'block_half', [real(dp) :: (blocks(ib)%half, ib = 1, nblocks)])
+    call checkpoint_put(ck, 'number', [integer :: (blocks(ib)%number, ib = 1, nblocks)])
+    do j = 1, size(block_fields)
+       call collect(blocks, nblocks, trim(block_fields(j)), flat)
+       call checkpoint_put(ck, trim(block_fields(j)), flat)
+    end do
+    call checkpoint_end_write(ck)
+  end subroutine mpm_checkpoint_save
+
+  ! ------------------------------------------------------------------------------ reading
+
+  !> Read this rank's checkpoint into `blocks` (replacing what the set-up generated) and `sv`.
+  !> The grid, walls and materials must be set up already (nd, nc, ns: dimensions, stress
+  !> components, stencil nodes). Collective; on a problem `err` is raised on every rank.
+  subroutine mpm_checkpoint_load(base, comm, m, nd, nc, ns, blocks, nblocks, sv, err)
+    character(len=*), intent(in) :: base
+    type(MPI_Comm), intent(in) :: comm
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: nd, nc, ns
+    type(particle_block_t), allocatable, intent(inout) :: blocks(:)
+    integer, intent(out) :: nblocks
+    type(mpm_saved_t), intent(out) :: sv
+    type(error_t), intent(inout) :: err
+    type(checkpoint_t) :: ck
+    type(checkpoint_header_t) :: header
+    real(dp), allocatable :: saved(:), scalars(:), half(:), flat(:)
+    integer, allocatable :: info(:, :), number(:)
+    integer :: n_items, counters(n_counters), ib, j, rank, nranks, nw, off
+    character(len=:), allocatable :: msg, file
+    logical :: any_failed
+
+    call MPI_Comm_rank(comm, rank)
+    call MPI_Comm_size(comm, nranks)
+    nblocks = 0
+    file = checkpoint_file_name(base, rank)
+    call checkpoint_begin_read(ck, base, comm, header, err)
+    if (err%raised) then
+       if (index(err%message, 'this run has') > 0) then
+          call add_expectation(err, 'a restart on as many ranks as the run that wrote the checkpoint')
+       else
+          call add_expectation(err, 'a checkpoint ' // base // '.rst.* written by an earlier run of this scene on ' // &
+               int_to_str(nranks) // ' rank(s) with the same --output (*RESTART, WRITE or --stop-after)')
+       end if
+       return
+    end if
+    sv%step = header%step
+    sv%increment = header%increment
+    sv%step_time = header%step_time
+    sv%total_time = header%total_time
+    sv%dt = header%dt
+    sv%frames = header%frame_count
+    sv%rows = header%history_rows
+
+    ! The scene first: a changed scene must say so, not fail on some array's shape later.
+    n_items = 0
+    call checkpoint_get(ck, 'scene_items', n_items, err)
+    if (err%raised) return
+    allocate (saved(max(n_items, 0)))
+    call checkpoint_get(ck, 'scene', saved, err)
+    if (err%raised) return
+    call compare_scene(m, saved, msg)
+    call agree_on_error(comm, allocated(msg), msg, any_failed, file)
+    if (any_failed) then
+       call raise_error(file, 0, msg, err)
+       return
+    end if
+
+    counters = 0
+    call checkpoint_get(ck, 'counters', counters, err)
+    allocate (scalars(n_scalars))
+    scalars = 0
+    call checkpoint_get(ck, 'scalars', scalars, err)
+    nw = size(m%mpm%walls)
+    allocate (sv%wall_force(3, nw), sv%wall_impulse(3, nw), sv%wall_force_row(3, nw))
+    sv%wall_force = 0
+    sv%wall_impulse = 0
+    sv%wall_force_row = 0
+    call checkpoint_get(ck, 'wall_force', sv%wall_force, err)
+    call checkpoint_get(ck, 'wall_impulse', sv%wall_impulse, err)
+    call checkpoint_get(ck, 'wall_force_row', sv%wall_force_row, err)
+    if (err%raised) return
+    call unpack_scalars(scalars, sv)
+    sv%next_number = counters(1)
+    sv%n_initial = counters(2)
+    sv%n_in = counters(3)
+    sv%n_out = counters(4)
+    sv%n_guarded = counters(5)
+    nblocks = counters(6)
+
+    ! The block table, checked before anything is allocated from it (a damaged file must not
+    ! make this rank allocate nonsense while the others wait).
+    if (nblocks < 0) msg = 'damaged file: ' // int_to_str(nblocks) // ' particle blocks'
+    call agree_on_error(comm, allocated(msg), msg, any_failed, file)
+    if (any_failed) then
+       call raise_error(file, 0, msg, err)
+       nblocks = 0
+       return
+    end if
+    allocate (info(4, nblocks), half(nblocks))
+    info = 0
+    half = 0
+    call checkpoint_get(ck, 'block_info', info, err)
+    call checkpoint_get(ck, 'block_half', half, err)
+    if (err%raised) then
+       nblocks = 0
+       return
+    end if
+    do ib = 1, nblocks
+       if (info(1, ib) < 1 .or. info(1, ib) > particle_block_size .or. info(2, ib) < 1 .or. &
+            info(2, ib) > m%n_materials .or. info(3, ib) < 1 .or. info(4, ib) < 1) then
+          msg = 'damaged file: block ' // int_to_str(ib) // ' has ' // int_to_str(info(1, ib)) // &
+               ' particles of material ' // int_to_str(info(2, ib)) // '; expected 1 to ' // &
+               int_to_str(particle_block_size) // ' particles of a material 1 to ' // int_to_str(m%n_materials)
+          exit
+       end if
+    end do
+    call agree_on_error(comm, allocated(msg), msg, any_failed, file)
+    if (any_failed) then
+       call raise_error(file, 0, msg, err)
+       nblocks = 0
+       return
+    end if
+
+    if (allocated(blocks)) deallocate (blocks)
+    ! room to grow: inflow appends blocks (mpm_run doubles the list when it is full)
+    allocate (blocks(max(16, 2 * nblocks)))
+    do ib = 1, nblocks
+       call block_allocate(blocks(ib), info(1, ib), nd, nc, info(3, ib), info(4, ib), ns)
+       blocks(ib)%material = info(2, ib)
+       blocks(ib)%half = half(ib)
+    end do
+    ! every field's flat array has the length the allocated blocks give it (checked by the read)
+    allocate (number(sum(info(1, :))))
+    number = 0
+    call checkpoint_get(ck, 'number', number, err)
+    off = 0
+    do ib = 1, nblocks
+       blocks(ib)%number = number(off + 1:off + blocks(ib)%count)
+       off = off + blocks(ib)%count
+    end do
+    do j = 1, size(block_fields)
+       call collect(blocks, nblocks, trim(block_fields(j)), flat)
+       call checkpoint_get(ck, trim(block_fields(j)), flat, err)
+       if (err%raised) exit
+       call distribute(flat, trim(block_fields(j)), blocks, nblocks)
+    end do
+    if (.not. err%raised) call checkpoint_end_read(ck, err)
+  end subroutine mpm_checkpoint_load
+
+  !> Reopen the outputs of the interrupted run at the checkpoint: BASE.h5 keeps its first
+  !> `frames` frames (rank 0 writes it), BASE_history.csv its first `rows` rows. Collective.
+  subroutine mpm_restart_outputs(base, comm, g, ncomp, nsdv, columns, frames, rows, wr, hist, err)
+    character(len=*), intent(in) :: base
+    type(MPI_Comm), intent(in) :: comm
+    type(grid_t), intent(in) :: g
+    integer, intent(in) :: ncomp, nsdv
+    character(len=*), intent(in) :: columns(:)
+    integer, intent(in) :: frames, rows
+    type(mpm_writer_t), intent(inout) :: wr
+    type(history_t), intent(inout) :: hist
+    type(error_t), intent(inout) :: err
+    type(error_t) :: e
+    character(len=:), allocatable :: msg
+    integer :: rank
+    logical :: any_failed
+
+    call MPI_Comm_rank(comm, rank)
+    if (rank == 0) call mpm_writer_open(wr, base, g, ncomp, nsdv, restart_frames=frames, err=e)
+    if (e%raised) msg = e%message
+    call agree_on_error(comm, e%raised, msg, any_failed)
+    if (any_failed) then
+       err%raised = .true.
+       err%message = msg
+       call add_expectation(err, 'the field output of the run that wrote the checkpoint')
+       return
+    end if
+    call history_open(hist, base // '_history.csv', columns, comm, restart_rows=rows, err=err)
+    if (err%raised) call add_expectation(err, 'the history of the run that wrote the checkpoint')
+  end subroutine mpm_restart_outputs
+
+  !> End a restart that cannot continue: the error is the same on every rank (agreed), rank 0
+  !> says it once, all ranks leave MPI cleanly, exit status 2 without a backtrace.
+  subroutine mpm_restart_stop(comm, err)
+    type(MPI_Comm), intent(in) :: comm
+    type(error_t), intent(in) :: err
+    integer :: rank
+
+    call MPI_Comm_rank(comm, rank)
+    if (rank == 0) then
+       write (error_unit, '(a)') 'bulkflow: error: ' // err%message
+       flush (error_unit)
+    end if
+    call MPI_Finalize()
+    error stop 2, quiet=.true.
+  end subroutine mpm_restart_stop
+
+  !> Append "; expected <what>" unless the message says what was expected already.
+  subroutine add_expectation(err, what)
+    type(error_t), intent(inout) :: err
+    character(len=*), intent(in) :: what
+
+    if (.not. allocated(err%message)) err%message = 'restart failed'
+    if (index(err%message, 'expected') == 0) err%message = err%message // '; expected ' // what
+  end subroutine add_expectation
+
+  ! ------------------------------------------------------------------------------ block fields
+
+  !> One particle field of every block, flattened in block order (each block's array in
+  !> Fortran element order).
+  subroutine collect(blocks, nblocks, name, flat)
+    type(particle_block_t), intent(in) :: blocks(:)
+    integer, intent(in) :: nblocks
+    character(len=*), intent(in) :: name
+    real(dp), allocatable, intent(inout) :: flat(:)
+    integer :: ib, off, n
+
+    n = 0
+    do ib = 1, nblocks
+       n = n + field_size(blocks(ib), name)
+    end do
+    if (allocated(flat)) deallocate (flat)
+    allocate (flat(n))
+    off = 0
+    do ib = 1, nblocks
+       associate (b => blocks(ib))
+         n = field_size(b, name)
+         select case (name)
+         case ('x')
+            flat(off + 1:off + n) = reshape(b%x, [n])
+         case ('v')
+            flat(off + 1:off + n) = reshape(b%v, [n])
+         case ('mass')
+            flat(off + 1:off + n) = b%mass
+         case ('vol0')
+            flat(off + 1:off + n) = b%vol0
+         case ('f')
+            flat(off + 1:off + n) = reshape(b%f, [n])
+         case ('rot')
+            flat(off + 1:off + n) = reshape(b%rot, [n])
+         case ('stress')
+            flat(off + 1:off + n) = reshape(b%stress, [n])
+         case ('stress_global')
+            flat(off + 1:off + n) = reshape(b%stress_global, [n])
+         case ('state')
+            flat(off + 1:off + n) = reshape(b%state, [n])
+         case ('field')
+            flat(off + 1:off + n) = reshape(b%field, [n])
+         case ('e_int')
+            flat(off + 1:off + n) = b%e_int
+         case ('e_inel')
+            flat(off + 1:off + n) = b%e_inel
+         case ('log_strain')
+            flat(off + 1:off + n) = reshape(b%log_strain, [n])
+         end select
+       end associate
+       off = off + n
+    end do
+  end subroutine collect
+
+  !> The inverse of collect: the blocks are allocated with their shapes already.
+  subroutine distribute(flat, name, blocks, nblocks)
+    real(dp), intent(in) :: flat(:)
+    character(len=*), intent(in) :: name
+    type(particle_block_t), intent(inout) :: blocks(:)
+    integer, intent(in) :: nblocks
+    integer :: ib, off, n
+
+    off = 0
+    do ib = 1, nblocks
+       associate (b => blocks(ib))
+         n = field_size(b, name)
+         select case (name)
+         case ('x')
+            b%x = reshape(flat(off + 1:off + n), shape(b%x))
+         case ('v')
+            b%v = reshape(flat(off + 1:off + n), shape(b%v))
+         case ('mass')
+            b%mass = flat(off + 1:off + n)
+         case ('vol0')
+            b%vol0 = flat(off + 1:off + n)
+         case ('f')
+            b%f = reshape(flat(off + 1:off + n), shape(b%f))
+         case ('rot')
+            b%rot = reshape(flat(off + 1:off + n), shape(b%rot))
+         case ('stress')
+            b%stress = reshape(flat(off + 1:off + n), shape(b%stress))
+         case ('stress_global')
+            b%stress_global = reshape(flat(off + 1:off + n), shape(b%stress_global))
+         case ('state')
+            b%state = reshape(flat(off + 1:off + n), shape(b%state))
+         case ('field')
+            b%field = reshape(flat(off + 1:off + n), shape(b%field))
+         case ('e_int')
+            b%e_int = flat(off + 1:off + n)
+         case ('e_inel')
+            b%e_inel = flat(off + 1:off + n)
+         case ('log_strain')
+            b%log_strain = reshape(flat(off + 1:off + n), shape(b%log_strain))
+         end select
+       end associate
+       off = off + n
+    end do
+  end subroutine distribute
+
+  pure integer function field_size(b, name) result(n)
+    type(particle_block_t), intent(in) :: b
+    character(len=*), intent(in) :: name
+
+    select case (name)
+    case ('x')
+       n = size(b%x)
+    case ('v')
+       n = size(b%v)
+    case ('f')
+       n = size(b%f)
+    case ('rot')
+       n = size(b%rot)
+    case ('stress')
+       n = size(b%stress)
+    case ('stress_global')
+       n = size(b%stress_global)
+    case ('state')
+       n = size(b%state)
+    case ('field')
+       n = size(b%field)
+    case ('log_strain')
+       n = size(b%log_strain)
+    case default
+       ! mass, vol0, e_int, e_inel: one value per particle
+       n = b%count
+    end select
+  end function field_size
+
+  ! ------------------------------------------------------------------------------ scalars
+
+  pure function pack_scalars(sv) result(r)
+    type(mpm_saved_t), intent(in) :: sv
+    real(dp) :: r(n_scalars)
+
+    r = [sv%dt_stable, sv%mass_initial, sv%mass_in, sv%mass_out, sv%mass_cutoff, sv%e_kinetic, &
+         sv%e_internal, sv%w_external, sv%e_walls, sv%e_damping, sv%e_out, sv%e_in, sv%gravity, &
+         sv%impulse_time, sv%next_field, sv%next_history, sv%last_row_time, sv%last_row_out]
+  end function pack_scalars
+
+  !> The inverse of pack_scalars (time, step time and Δt are in the header).
+  pure subroutine unpack_scalars(r, sv)
+    real(dp), intent(in) :: r(n_scalars)
+    type(mpm_saved_t), intent(inout) :: sv
+
+    sv%dt_stable = r(1)
+    sv%mass_initial = r(2)
+    sv%mass_in = r(3)
+    sv%mass_out = r(4)
+    sv%mass_cutoff = r(5)
+    sv%e_kinetic = r(6)
+    sv%e_internal = r(7)
+    sv%w_external = r(8)
+    sv%e_walls = r(9)
+    sv%e_damping = r(10)
+    sv%e_out = r(11)
+    sv%e_in = r(12)
+    sv%gravity = r(13:15)
+    sv%impulse_time = r(16)
+    sv%next_field = r(17)
+    sv%next_history = r(18)
+    sv%last_row_time = r(19)
+    sv%last_row_out = r(20)
+  end subroutine unpack_scalars
+
+  ! ------------------------------------------------------------------------------ scene
+
+  !> The scene's numbers that a restart must find unchanged, with a name for each. All counts
+  !> come first, so a structural change (another wall, step or material) is named as such and
+  !> not as some shifted value.
+  subroutine scene_fingerprint(m, values, names)
+    type(model_t), intent(in) :: m
+    real(dp), allocatable, intent(out) :: values(:)
+    character(len=item_length), allocatable, intent(out) :: names(:)
+    integer :: n, k, j, s
+    character(len=:), allocatable :: w
+
+    allocate (values(256), names(256))
+    n = 0
+    associate (mpm => m%mpm)
+      ! counts
+      call add('dimensions of *MPM GRID', real(mpm%ndim, dp))
+      call add('number of materials', real(m%n_materials, dp))
+      call add('number of *PARTICLES regions', real(size(mpm%regions), dp))
+      call add('number of *MPM WALL', real(size(mpm%walls), dp))
+      call add('number of steps', real(m%n_steps, dp))
+      call add('number of amplitudes', real(m%n_amplitudes, dp))
+      do k = 1, m%n_materials
+         call add('number of *DEPVAR of material ' // trim(m%materials(k)%name), real(m%materials(k)%nstatev, dp))
+         call add('number of constants of material ' // trim(m%materials(k)%name), &
+              real(material_constants(m, k), dp))
+      end do
+      do k = 1, size(mpm%regions)
+         call add('number of polygon vertices of *PARTICLES region ' // int_to_str(k), &
+              real(region_vertices(m, k), dp))
+      end do
+      do s = 1, m%n_steps
+         call add('number of gravity loads in step ' // int_to_str(s), real(step_gravities(m, s), dp))
+         call add('number of field outputs in step ' // int_to_str(s), real(step_field_outputs(m, s), dp))
+         call add('number of history outputs in step ' // int_to_str(s), real(step_history_outputs(m, s), dp))
+      end do
+      do k = 1, m%n_amplitudes
+         call add('number of points of amplitude ' // trim(m%amplitudes(k)%name), real(amplitude_points(m, k), dp))
+      end do
+
+      ! values
+      call add('SHAPE of *MPM GRID', real(mpm%shape, dp))
+      call add('CELL of *MPM GRID', mpm%cell)
+      do j = 1, 3
+         call add('grid lower corner ' // int_to_str(j), mpm%lo(j))
+         call add('grid upper corner ' // int_to_str(j), mpm%hi(j))
+      end do
+      call add('vertical axis', real(mpm%vertical, dp))
+      call add('*OUTFLOW', merge(1.0_dp, 0.0_dp, mpm%outflow))
+      call add('*OUTFLOW, BELOW', mpm%outflow_level)
+      do k = 1, m%n_materials
+         associate (mat => m%materials(k))
+           call add('density of material ' // trim(mat%name), mat%density)
+           call add('*USER DEFINED FIELD of material ' // trim(mat%name), real(mat%nfieldv, dp))
+           do j = 1, material_constants(m, k)
+              call add('constant ' // int_to_str(j) // ' of material ' // trim(mat%name), mat%props(j))
+           end do
+         end associate
+      end do
+      do k = 1, size(mpm%regions)
+         associate (r => mpm%regions(k))
+           w = ' of *PARTICLES region ' // int_to_str(k)
+           call add('MATERIAL' // w, real(r%material, dp))
+           call add('TYPE' // w, real(r%kind, dp))
+           call add('PPC' // w, real(r%ppc, dp))
+           do j = 1, 3
+              call add('lower corner ' // int_to_str(j) // w, r%lo(j))
+              call add('upper corner ' // int_to_str(j) // w, r%hi(j))
+              call add('velocity ' // int_to_str(j) // w, r%velocity(j))
+           end do
+           do j = 1, region_vertices(m, k)
+              call add('vertex ' // int_to_str(j) // ' x' // w, r%polygon(1, j))
+              call add('vertex ' // int_to_str(j) // ' y' // w, r%polygon(2, j))
+           end do
+         end associate
+      end do
+      do k = 1, size(mpm%walls)
+         associate (wl => mpm%walls(k))
+           w = ' of *MPM WALL ' // trim(wl%name)
+           call add('TYPE' // w, real(wl%kind, dp))
+           call add('FRICTION' // w, wl%friction)
+           call add('REACH' // w, wl%reach)
+           do j = 1, 3
+              call add('point 1, coordinate ' // int_to_str(j) // w, wl%p0(j))
+              call add('point 2, coordinate ' // int_to_str(j) // w, wl%p1(j))
+              call add('normal ' // int_to_str(j) // w, wl%normal(j))
+              call add('box lower corner ' // int_to_str(j) // w, wl%lo(j))
+              call add('box upper corner ' // int_to_str(j) // w, wl%hi(j))
+           end do
+           call add('bounds' // w, merge(1.0_dp, 0.0_dp, wl%bounded))
+           do s = 1, m%n_steps
+              call add('active in step ' // int_to_str(s) // w, merge(1.0_dp, 0.0_dp, wl%active(s)))
+           end do
+         end associate
+      end do
+      do s = 1, m%n_steps
+         associate (st => m%steps(s), ms => mpm%steps(s))
+           w = ' of step ' // int_to_str(s)
+           call add('time period' // w, st%period)
+           call add('fixed time increment' // w, st%dt_fixed)
+           call add('*MPM CONTROLS, FLIP' // w, ms%flip)
+           call add('*MPM CONTROLS, CFL' // w, ms%cfl)
+           call add('*MPM CONTROLS, DAMPING' // w, ms%damping)
+           call add('*INFLOW' // w, merge(1.0_dp, 0.0_dp, ms%inflow%on))
+           call add('*INFLOW, MATERIAL' // w, real(ms%inflow%material, dp))
+           call add('*INFLOW, PPC' // w, real(ms%inflow%ppc, dp))
+           call add('*INFLOW, LEVEL' // w, ms%inflow%level)
+           do j = 1, 3
+              call add('*INFLOW band lower end ' // int_to_str(j) // w, ms%inflow%lo(j))
+              call add('*INFLOW band upper end ' // int_to_str(j) // w, ms%inflow%hi(j))
+           end do
+           do j = 1, step_gravities(m, s)
+              associate (gl => st%gravity(j))
+                call add('gravity ' // int_to_str(j) // ' magnitude' // w, gl%magnitude)
+                call add('gravity ' // int_to_str(j) // ' direction 1' // w, gl%direction(1))
+                call add('gravity ' // int_to_str(j) // ' direction 2' // w, gl%direction(2))
+                call add('gravity ' // int_to_str(j) // ' direction 3' // w, gl%direction(3))
+                call add('gravity ' // int_to_str(j) // ' amplitude' // w, real(gl%amplitude, dp))
+              end associate
+           end do
+           ! the output schedule: the frames and rows kept by a restart must be the same
+           do j = 1, step_field_outputs(m, s)
+              call add('field output ' // int_to_str(j) // ' TIME INTERVAL' // w, st%field_outputs(j)%time_interval)
+              call add('field output ' // int_to_str(j) // ' NUMBER INTERVAL' // w, &
+                   real(st%field_outputs(j)%number_interval, dp))
+           end do
+           do j = 1, step_history_outputs(m, s)
+              call add('history output ' // int_to_str(j) // ' TIME INTERVAL' // w, &
+                   st%history_outputs(j)%time_interval)
+              call add('history output ' // int_to_str(j) // ' NUMBER INTERVAL' // w, &
+                   real(st%history_outputs(j)%number_interval, dp))
+           end do
+         end associate
+      end do
+      do k = 1, m%n_amplitudes
+         associate (a => m%amplitudes(k))
+           w = ' of amplitude ' // trim(a%name)
+           call add('DEFINITION' // w, real(a%kind, dp))
+           call add('TIME' // w, merge(1.0_dp, 0.0_dp, a%total_time))
+           do j = 1, amplitude_points(m, k)
+              call add('time of point ' // int_to_str(j) // w, a%t(j))
+              call add('value of point ' // int_to_str(j) // w, a%a(j))
+           end do
+         end associate
+      end do
+    end associate
+    values = values(1:n)
+    names = names(1:n)
+
+  contains
+
+    subroutine add(name, value)
+      character(len=*), intent(in) :: name
+      real(dp), intent(in) :: value
+      real(dp), allocatable :: grown_v(:)
+      character(len=item_length), allocatable :: grown_n(:)
+
+      if (n == size(values)) then
+         allocate (grown_v(2 * n), grown_n(2 * n))
+         grown_v(1:n) = values
+         grown_n(1:n) = names
+         call move_alloc(grown_v, values)
+         call move_alloc(grown_n, names)
+      end if
+      n = n + 1
+      values(n) = value
+      names(n) = name
+    end subroutine add
+
+  end subroutine scene_fingerprint
+
+  !> msg allocated when the saved fingerprint differs from this scene's: the first item that
+  !> differs, its value now and in the checkpoint.
+  subroutine compare_scene(m, saved, msg)
+    type(model_t), intent(in) :: m
+    real(dp), intent(in) :: saved(:)
+    character(len=:), allocatable, intent(inout) :: msg
+    real(dp), allocatable :: now(:)
+    character(len=item_length), allocatable :: names(:)
+    integer :: i
+
+    call scene_fingerprint(m, now, names)
+    do i = 1, min(size(now), size(saved))
+       ! bitwise: a restart repeats the run only with exactly the same numbers
+       if (transfer(now(i), 0_int64) == transfer(saved(i), 0_int64)) cycle
+       msg = 'the scene is not the one this checkpoint was written for: ' // trim(names(i)) // ' is ' // &
+            shortest(now(i)) // ', the checkpoint''s scene had ' // shortest(saved(i)) // '; expected the ' // &
+            'unchanged scene of the interrupted run (or a new run without --restart)'
+       return
+    end do
+    if (size(now) /= size(saved)) msg = 'the scene is not the one this checkpoint was written for (' // &
+         int_to_str(size(now)) // ' scene items, the checkpoint has ' // int_to_str(size(saved)) // &
+         '); expected the unchanged scene of the interrupted run (or a new run without --restart)'
+  end subroutine compare_scene
+
+  !> x with as few digits as read back to the same double (5.0E-02, not 0.50000000000000003E-1).
+  function shortest(x) result(text)
+    real(dp), intent(in) :: x
+    character(len=:), allocatable :: text
+    character(len=40) :: buf, fmt
+    real(dp) :: y
+    integer :: d, ios
+
+    if (abs(x - anint(x)) <= 0 .and. abs(x) < 1.0e9_dp) then
+       text = int_to_str(nint(x))
+       return
+    end if
+    do d = 1, 16
+       write (fmt, '(a,i0,a)') '(es40.', d, ')'
+       write (buf, fmt) x
+       read (buf, *, iostat=ios) y
+       if (ios == 0 .and. transfer(y, 0_int64) == transfer(x, 0_int64)) exit
+    end do
+    text = trim(adjustl(buf))
+  end function shortest
+
+  pure integer function material_constants(m, k)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: k
+    material_constants = 0
+    if (allocated(m%materials(k)%props)) material_constants = size(m%materials(k)%props)
+  end function material_constants
+
+  pure integer function region_vertices(m, k)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: k
+    region_vertices = 0
+    if (allocated(m%mpm%regions(k)%polygon)) region_vertices = size(m%mpm%regions(k)%polygon, 2)
+  end function region_vertices
+
+  pure integer function step_gravities(m, s)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: s
+    step_gravities = 0
+    if (allocated(m%steps(s)%gravity)) step_gravities = size(m%steps(s)%gravity)
+  end function step_gravities
+
+  pure integer function step_field_outputs(m, s)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: s
+    step_field_outputs = 0
+    if (allocated(m%steps(s)%field_outputs)) step_field_outputs = size(m%steps(s)%field_outputs)
+  end function step_field_outputs
+
+  pure integer function step_history_outputs(m, s)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: s
+    step_history_outputs = 0
+    if (allocated(m%steps(s)%history_outputs)) step_history_outputs = size(m%steps(s)%history_outputs)
+  end function step_history_outputs
+
+  pure integer function amplitude_points(m, k)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: k
+    amplitude_points = 0
+    if (allocated(m%amplitudes(k)%t)) amplitude_points = size(m%amplitudes(k)%t)
+  end function amplitude_points
+end module mpm_checkpoint
