@@ -31,7 +31,7 @@ module mpm_run
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
   use mpm_scene, only: mpm_scene_t, particle_region_t, mpm_inflow_t, region_box, region_polygon
-  use mpm_grid, only: grid_t, grid_init, grid_reset
+  use mpm_grid, only: grid_t, grid_init, grid_reset_sums
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_keep, block_grow
   use mpm_shape, only: stencil_nodes_per_direction, block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, gather_gradient
@@ -610,7 +610,7 @@ contains
 
     ! stencils and P2G
     call timer_start(fx%timers, fx%id(fx_p2g))
-    call grid_reset(st%g)
+    call grid_reset_sums(st%g)
     do ib = 1, st%nblocks
        call stencil(m, st, st%blocks(ib))
        call p2g(st, st%blocks(ib))
@@ -737,18 +737,23 @@ contains
   subroutine p2g(st, b)
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(in) :: b
-    integer :: p, nd, ns, nb
-    real(dp) :: vol
+    integer :: p, k, nd, ns, nb
+    real(dp) :: vol(b%count)
     real(dp) :: mv(b%count, st%nd), vs(b%count, st%nc), mg(b%count, st%nd)
 
     nd = st%nd
     ns = st%ns
     nb = b%count
+    ! column by column (particle index innermost): the row-wise form was a quarter of p2g
     do p = 1, nb
-       vol = b%vol0(p) * det_f(b, p, nd)
-       vs(p, :) = vol * b%stress_global(p, :)
-       mv(p, :) = b%mass(p) * b%v(p, :)
-       mg(p, :) = b%mass(p) * st%gravity(1:nd)
+       vol(p) = b%vol0(p) * det_f(b, p, nd)
+    end do
+    do k = 1, st%nc
+       vs(:, k) = vol * b%stress_global(:, k)
+    end do
+    do k = 1, nd
+       mv(:, k) = b%mass * b%v(:, k)
+       mg(:, k) = b%mass * st%gravity(k)
     end do
     call scatter_p2g(nb, ns, nd, st%nc, st%g%nn, b%node, b%w, b%dw, b%mass, mv, vs, mg, st%g%mass, st%g%mom, &
          st%g%force)
@@ -765,7 +770,11 @@ contains
     dt = st%dt
     do i = 1, st%g%nn
        st%g%active(i) = st%g%mass(i) > st%mass_cutoff
-       if (.not. st%g%active(i)) cycle
+       if (.not. st%g%active(i)) then
+          st%g%v_old(:, i) = 0
+          st%g%v_new(:, i) = 0
+          cycle
+       end if
        do k = 1, st%nd
           st%g%v_old(k, i) = st%g%mom(k, i) / st%g%mass(i)
           f = st%g%force(k, i)

@@ -91,7 +91,7 @@ contains
     real(dp), intent(in) :: lo, h, l, x(nb)
     integer, intent(out) :: base(nb)
     real(dp), intent(out) :: n1(nb, 3), d1(nb, 3)
-    integer :: p, a
+    integer :: p, a, k
     real(dp) :: xi, r, ar, sg, t, num, den
     logical :: centre, linear, tail
 
@@ -118,8 +118,13 @@ contains
        !   else             N = 0 (0/1)                 N' = 0 (0/1)
        do p = 1, nb
           xi = (x(p) - lo) / h
-          base(p) = nint(xi) - 1
-          do a = 1, 3
+          ! nint(xi) − 1 without nint's libm call (lround), which kept the loops scalar: the
+          ! same integer for xi ≥ 0 (xi − int(xi) is exact), negative (outside) for xi < 0.
+          k = int(xi)
+          base(p) = k - 1 + merge(1, 0, xi - k >= 0.5_dp)
+       end do
+       do a = 1, 3
+          do p = 1, nb
              ! r = x_p − x_I (signed distance to node base + a − 1)
              r = x(p) - (lo + (base(p) + a - 1) * h)
              ar = abs(r)
