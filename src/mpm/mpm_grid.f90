@@ -23,7 +23,7 @@ module mpm_grid
      procedure :: position => grid_position
   end type grid_t
 
-  public :: grid_init, grid_reset, grid_node_index
+  public :: grid_init, grid_reset, grid_reset_sums, grid_node_index
 
 contains
 
@@ -49,14 +49,22 @@ contains
 
   subroutine grid_reset(g)
     type(grid_t), intent(inout) :: g
-    g%mass = 0
+    call grid_reset_sums(g)
     g%mass_own = 0
-    g%mom = 0
-    g%force = 0
     g%v_old = 0
     g%v_new = 0
     g%active = .false.
   end subroutine grid_reset
+
+  !> Zero what P2G sums into (mass, momentum, force). The increment calls only this: mass_own,
+  !> active, v_old and v_new are written for every node after P2G (the grid update writes
+  !> zero velocities on inactive nodes), so zeroing them as well was wasted stores.
+  subroutine grid_reset_sums(g)
+    type(grid_t), intent(inout) :: g
+    g%mass = 0
+    g%mom = 0
+    g%force = 0
+  end subroutine grid_reset_sums
 
   !> Position of node `node` (1-based index).
   pure function grid_position(g, node) result(x)

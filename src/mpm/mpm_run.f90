@@ -33,9 +33,10 @@ module mpm_run
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
   use mpm_scene, only: mpm_scene_t, particle_region_t, mpm_inflow_t, region_box, region_polygon
-  use mpm_grid, only: grid_t, grid_init, grid_reset
+  use mpm_grid, only: grid_t, grid_init, grid_reset_sums
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_keep, block_grow
   use mpm_shape, only: stencil_nodes_per_direction, block_stencil
+  use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, gather_gradient
   use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance, &
        wall_slide_velocity
   use mpm_mirror, only: mirror_plane_t, mirror_plane_setup, mirror_fold, mirror_fold_momentum
@@ -640,7 +641,7 @@ contains
 
     ! stencils and P2G
     call timer_start(fx%timers, fx%id(fx_p2g))
-    call grid_reset(st%g)
+    call grid_reset_sums(st%g)
     do ib = 1, st%nblocks
        call stencil(m, st, st%blocks(ib))
        call p2g(st, st%blocks(ib))
@@ -767,137 +768,27 @@ contains
   subroutine p2g(st, b)
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(in) :: b
-    integer :: p, nd, ns, nb
-    real(dp) :: vol
+    integer :: p, k, nd, ns, nb
+    real(dp) :: vol(b%count)
     real(dp) :: mv(b%count, st%nd), vs(b%count, st%nc), mg(b%count, st%nd)
 
     nd = st%nd
     ns = st%ns
     nb = b%count
+    ! column by column (particle index innermost): the row-wise form was a quarter of p2g
     do p = 1, nb
-       vol = b%vol0(p) * det_f(b, p, nd)
-       vs(p, :) = vol * b%stress_global(p, :)
-       mv(p, :) = b%mass(p) * b%v(p, :)
-       mg(p, :) = b%mass(p) * st%gravity(1:nd)
+       vol(p) = b%vol0(p) * det_f(b, p, nd)
     end do
-    if (nd == 2) then
-       call scatter_2d(nb, ns, st%g%nn, b%node, b%w, b%dw, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
-    else
-       call scatter_3d(nb, ns, st%g%nn, b%node, b%w, b%dw, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
-    end if
+    do k = 1, st%nc
+       vs(:, k) = vol * b%stress_global(:, k)
+    end do
+    do k = 1, nd
+       mv(:, k) = b%mass * b%v(:, k)
+       mg(:, k) = b%mass * st%gravity(k)
+    end do
+    call scatter_p2g(nb, ns, nd, st%nc, st%g%nn, b%node, b%w, b%dw, b%mass, mv, vs, mg, st%g%mass, st%g%mom, &
+         st%g%force)
   end subroutine p2g
-
-  !> The P2G scatter of a 2D block. Explicit-shape dummies: on the allocatable components the
-  !> compiler reloaded the array descriptors at every store (the loop is store-bound).
-  pure subroutine scatter_2d(nb, ns, nn, node, w, dw, mp, mv, vs, mg, gmass, gmom, gforce)
-    integer, intent(in) :: nb, ns, nn
-    integer, intent(in) :: node(nb, ns)
-    real(dp), intent(in) :: w(nb, ns), dw(nb, 2 * ns), mp(nb), mv(nb, 2), vs(nb, 4), mg(nb, 2)
-    real(dp), intent(inout) :: gmass(nn), gmom(2, nn), gforce(2, nn)
-    integer :: s, p, i
-    real(dp) :: wp, dx, dy
-
-    do s = 1, ns
-       do p = 1, nb
-          i = node(p, s)
-          wp = w(p, s)
-          dx = dw(p, s)
-          dy = dw(p, ns + s)
-          gmass(i) = gmass(i) + wp * mp(p)
-          gmom(1, i) = gmom(1, i) + wp * mv(p, 1)
-          gmom(2, i) = gmom(2, i) + wp * mv(p, 2)
-          gforce(1, i) = gforce(1, i) + (wp * mg(p, 1) - (vs(p, 1) * dx + vs(p, 4) * dy))
-          gforce(2, i) = gforce(2, i) + (wp * mg(p, 2) - (vs(p, 4) * dx + vs(p, 2) * dy))
-       end do
-    end do
-  end subroutine scatter_2d
-
-  !> The P2G scatter of a 3D block (stress in VUMAT order 11, 22, 33, 12, 23, 31).
-  pure subroutine scatter_3d(nb, ns, nn, node, w, dw, mp, mv, vs, mg, gmass, gmom, gforce)
-    integer, intent(in) :: nb, ns, nn
-    integer, intent(in) :: node(nb, ns)
-    real(dp), intent(in) :: w(nb, ns), dw(nb, 3 * ns), mp(nb), mv(nb, 3), vs(nb, 6), mg(nb, 3)
-    real(dp), intent(inout) :: gmass(nn), gmom(3, nn), gforce(3, nn)
-    integer :: s, p, i
-    real(dp) :: wp, dx, dy, dz
-
-    do s = 1, ns
-       do p = 1, nb
-          i = node(p, s)
-          wp = w(p, s)
-          dx = dw(p, s)
-          dy = dw(p, ns + s)
-          dz = dw(p, 2 * ns + s)
-          gmass(i) = gmass(i) + wp * mp(p)
-          gmom(1, i) = gmom(1, i) + wp * mv(p, 1)
-          gmom(2, i) = gmom(2, i) + wp * mv(p, 2)
-          gmom(3, i) = gmom(3, i) + wp * mv(p, 3)
-          gforce(1, i) = gforce(1, i) + (wp * mg(p, 1) - (vs(p, 1) * dx + vs(p, 4) * dy + vs(p, 6) * dz))
-          gforce(2, i) = gforce(2, i) + (wp * mg(p, 2) - (vs(p, 4) * dx + vs(p, 2) * dy + vs(p, 5) * dz))
-          gforce(3, i) = gforce(3, i) + (wp * mg(p, 3) - (vs(p, 6) * dx + vs(p, 5) * dy + vs(p, 3) * dz))
-       end do
-    end do
-  end subroutine scatter_3d
-
-  !> Σ_s w v_new and Σ_s w (v_new − v_old) at the particles of a block (G2P gather).
-  pure subroutine gather_velocity(nb, ns, nd, nn, node, w, v_new, v_old, vpic, dv)
-    integer, intent(in) :: nb, ns, nd, nn
-    integer, intent(in) :: node(nb, ns)
-    real(dp), intent(in) :: w(nb, ns), v_new(nd, nn), v_old(nd, nn)
-    real(dp), intent(out) :: vpic(nb, nd), dv(nb, nd)
-    integer :: s, p, i, k
-
-    vpic = 0
-    dv = 0
-    do s = 1, ns
-       do p = 1, nb
-          i = node(p, s)
-          do k = 1, nd
-             vpic(p, k) = vpic(p, k) + w(p, s) * v_new(k, i)
-             dv(p, k) = dv(p, k) + w(p, s) * (v_new(k, i) - v_old(k, i))
-          end do
-       end do
-    end do
-  end subroutine gather_velocity
-
-  !> MUSL remap of a block: gmom += Σ_s w (m v)_p.
-  pure subroutine scatter_momentum(nb, ns, nd, nn, node, w, mv, gmom)
-    integer, intent(in) :: nb, ns, nd, nn
-    integer, intent(in) :: node(nb, ns)
-    real(dp), intent(in) :: w(nb, ns), mv(nb, nd)
-    real(dp), intent(inout) :: gmom(nd, nn)
-    integer :: s, p, i, k
-
-    do s = 1, ns
-       do p = 1, nb
-          i = node(p, s)
-          do k = 1, nd
-             gmom(k, i) = gmom(k, i) + w(p, s) * mv(p, k)
-          end do
-       end do
-    end do
-  end subroutine scatter_momentum
-
-  !> Velocity gradient L(p, a, c) = Σ_s v_a(node) ∂S/∂x_c of a block.
-  pure subroutine gather_gradient(nb, ns, nd, nn, node, dw, v, l)
-    integer, intent(in) :: nb, ns, nd, nn
-    integer, intent(in) :: node(nb, ns)
-    real(dp), intent(in) :: dw(nb, nd * ns), v(nd, nn)
-    real(dp), intent(out) :: l(nb, nd, nd)
-    integer :: s, p, i, a, c
-
-    l = 0
-    do s = 1, ns
-       do p = 1, nb
-          i = node(p, s)
-          do c = 1, nd
-             do a = 1, nd
-                l(p, a, c) = l(p, a, c) + v(a, i) * dw(p, (c - 1) * ns + s)
-             end do
-          end do
-       end do
-    end do
-  end subroutine gather_gradient
 
   !> v_I^n = p_I/m_I; [local damping f ← f − a|f| sgn v]; v_I^{n+1} = v_I^n + Δt f_I/m_I.
   subroutine grid_update(m, st)
@@ -910,7 +801,11 @@ contains
     dt = st%dt
     do i = 1, st%g%nn
        st%g%active(i) = st%g%mass(i) > st%mass_cutoff
-       if (.not. st%g%active(i)) cycle
+       if (.not. st%g%active(i)) then
+          st%g%v_old(:, i) = 0
+          st%g%v_new(:, i) = 0
+          cycle
+       end if
        do k = 1, st%nd
           st%g%v_old(k, i) = st%g%mom(k, i) / st%g%mass(i)
           f = st%g%force(k, i)

@@ -91,8 +91,9 @@ contains
     real(dp), intent(in) :: lo, h, l, x(nb)
     integer, intent(out) :: base(nb)
     real(dp), intent(out) :: n1(nb, 3), d1(nb, 3)
-    integer :: p, a
-    real(dp) :: xi, r, ar, sg
+    integer :: p, a, k
+    real(dp) :: xi, r, ar, sg, t, num, den
+    logical :: centre, linear, tail
 
     if (shape == shape_linear) then
        do p = 1, nb
@@ -107,27 +108,37 @@ contains
           d1(p, 3) = 0
        end do
     else
+       ! Branch-free, so the loop vectorises (the branches on the zone of each node were
+       ! mispredicted at random: the stencil was 11 % of a hopper run). Each zone's value is
+       ! num/den with that zone's own numerator and denominator, selected before the one
+       ! division, so every weight and gradient is the same double as the branched form's:
+       !   |r| < l          N = 1 − (r² + l²)/(2hl)     N' = −r/(hl)
+       !   l ≤ |r| ≤ h − l  N = 1 − |r|/h               N' = −sgn(r)/h
+       !   h − l < |r| < h + l  N = (h + l − |r|)²/(4hl)  N' = −sgn(r)(h + l − |r|)/(2hl)
+       !   else             N = 0 (0/1)                 N' = 0 (0/1)
        do p = 1, nb
           xi = (x(p) - lo) / h
-          base(p) = nint(xi) - 1
-          do a = 1, 3
+          ! nint(xi) − 1 without nint's libm call (lround), which kept the loops scalar: the
+          ! same integer for xi ≥ 0 (xi − int(xi) is exact), negative (outside) for xi < 0.
+          k = int(xi)
+          base(p) = k - 1 + merge(1, 0, xi - k >= 0.5_dp)
+       end do
+       do a = 1, 3
+          do p = 1, nb
              ! r = x_p − x_I (signed distance to node base + a − 1)
              r = x(p) - (lo + (base(p) + a - 1) * h)
              ar = abs(r)
              sg = sign(1.0_dp, r)
-             if (ar < l) then
-                n1(p, a) = 1 - (r * r + l * l) / (2 * h * l)
-                d1(p, a) = -r / (h * l)
-             else if (ar <= h - l) then
-                n1(p, a) = 1 - ar / h
-                d1(p, a) = -sg / h
-             else if (ar < h + l) then
-                n1(p, a) = (h + l - ar)**2 / (4 * h * l)
-                d1(p, a) = -sg * (h + l - ar) / (2 * h * l)
-             else
-                n1(p, a) = 0
-                d1(p, a) = 0
-             end if
+             centre = ar < l
+             linear = ar <= h - l
+             tail = ar < h + l
+             t = h + l - ar
+             num = merge(r * r + l * l, merge(ar, merge(t**2, 0.0_dp, tail), linear), centre)
+             den = merge(2 * h * l, merge(h, merge(4 * h * l, 1.0_dp, tail), linear), centre)
+             n1(p, a) = merge(1 - num / den, num / den, centre .or. linear)
+             num = merge(-r, merge(-sg, merge(-sg * t, 0.0_dp, tail), linear), centre)
+             den = merge(h * l, merge(h, merge(2 * h * l, 1.0_dp, tail), linear), centre)
+             d1(p, a) = num / den
           end do
        end do
     end if
