@@ -14,6 +14,7 @@ module driver_output
        field_writer_coordinates, field_writer_node_field, field_writer_element_field, field_writer_close, &
        field_writer_frame_count
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
+  use output_timer, only: clock_text
   use fem_corotation, only: to_global
   use driver_stop_condition, only: count_stop_columns, add_stop_columns, stop_column_values
   implicit none
@@ -510,15 +511,4 @@ contains
          solver%increment, '  dt ', solver%dt, '  ETA ', clock_text(eta)
     flush (output_unit)
   end subroutine progress_line
-
-  function clock_text(seconds) result(text)
-    real(dp), intent(in) :: seconds
-    character(len=:), allocatable :: text
-    character(len=32) :: buf
-    integer :: s
-
-    s = nint(min(seconds, 3.6e7_dp))
-    write (buf, '(i0,a,i2.2,a,i2.2)') s / 3600, ':', mod(s / 60, 60), ':', mod(s, 60)
-    text = trim(buf)
-  end function clock_text
 end module driver_output

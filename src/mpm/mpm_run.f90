@@ -46,7 +46,8 @@ module mpm_run
   use driver_vumat_call, only: vumat_work_t, vumat_work_init, call_material, packaging_modulus
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
-  use output_timer, only: timer_set_t, timer_init, timer_register, timer_start, timer_stop, timer_report
+  use output_timer, only: timer_set_t, timer_init, timer_register, timer_start, timer_stop, timer_report, &
+       clock_text
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
   implicit none
   private
@@ -125,7 +126,7 @@ contains
     type(history_t) :: hist
     character(len=32), allocatable :: columns(:)
     real(dp) :: next_field, next_history, field_dt, history_dt, last_row_time, last_row_out
-    real(dp) :: period, eps
+    real(dp) :: period, eps, sim_start
     integer :: s, k, nsdv, first_step
     integer(int64) :: clock_last, clock_now, clock_rate, clock_start
     logical :: stop_now, resumed, history_due, field_due
@@ -157,6 +158,7 @@ contains
     end if
     call system_clock(clock_last, clock_rate)
     clock_start = clock_last
+    sim_start = st%total_time
     stop_now = .false.
     do s = first_step, m%n_steps
        ! a resumed step continues at the checkpoint's step time and output schedule
@@ -214,14 +216,22 @@ contains
              call system_clock(clock_now)
              if (real(clock_now - clock_last, dp) / real(clock_rate, dp) > 2.0_dp) then
                 clock_last = clock_now
-                write (output_unit, '(a,i0,a,es11.4,a,i0,a,es10.3,a,es11.4)') '  step ', s, '  t = ', &
-                     st%total_time, '  inc ', st%increment, '  dt ', st%dt, '  out kg (rank 0) ', st%mass_out
-                flush (output_unit)
+                call progress_line(m, st, s, real(clock_now - clock_start, dp) / real(clock_rate, dp), &
+                     sim_start)
              end if
           end if
           call timer_stop(fx%timers, fx%id(fx_output))
           if (stop_now) exit
        end do
+       if (progress .and. st%rank == 0 .and. .not. stop_now) then
+          ! one line per finished step: its end and the wall time so far (benchmarks split a
+          ! fill from the discharge with it)
+          call system_clock(clock_now)
+          write (output_unit, '(a,i0,a,i0,1x,a,a,es11.4,a,i0,a,f10.1,a)') '  step ', s, '/', m%n_steps, &
+               trim(m%steps(s)%name), ' done  t = ', st%total_time, '  inc ', st%increment, '  wall ', &
+               real(clock_now - clock_start, dp) / real(clock_rate, dp), ' s'
+          flush (output_unit)
+       end if
        if (stop_now) exit
     end do
     call system_clock(clock_now)
@@ -230,6 +240,25 @@ contains
     call history_close(hist)
     call summary(m, st, fx, stop_now)
   end subroutine mpm_run_scene
+
+  !> "  step 2/2 DISCHARGE  t = 1.2345E+00  inc 12345  dt 1.234E-04  out kg (rank 0) 12.3  ETA 0:04:10":
+  !> the ETA from this run's wall time per simulated second so far (since the restart, if any).
+  subroutine progress_line(m, st, s, elapsed, sim_start)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(in) :: st
+    integer, intent(in) :: s
+    real(dp), intent(in) :: elapsed, sim_start
+    real(dp) :: remaining, eta
+
+    remaining = m%steps(s)%period - st%step_time
+    if (s < m%n_steps) remaining = remaining + sum(m%steps(s + 1:m%n_steps)%period)
+    eta = 0
+    if (st%total_time > sim_start) eta = elapsed / (st%total_time - sim_start) * remaining
+    write (output_unit, '(a,i0,a,i0,1x,a,a,es11.4,a,i0,a,es10.3,a,es11.4,a,a)') '  step ', s, '/', m%n_steps, &
+         trim(m%steps(s)%name), '  t = ', st%total_time, '  inc ', st%increment, '  dt ', st%dt, &
+         '  out kg (rank 0) ', st%mass_out, '  ETA ', clock_text(eta)
+    flush (output_unit)
+  end subroutine progress_line
 
   ! ------------------------------------------------------------------------------ ranks
 

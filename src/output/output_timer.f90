@@ -24,7 +24,7 @@ module output_timer
   private
 
   public :: timer_set_t, timer_init, timer_register, timer_start, timer_stop
-  public :: timer_seconds, timer_report
+  public :: timer_seconds, timer_report, clock_text
 
   integer, parameter :: name_length = 32
 
@@ -229,4 +229,15 @@ contains
     seconds_between = real(to - from, dp) / real(rate, dp)
   end function seconds_between
 
+  !> A duration as h:mm:ss (progress lines' ETA).
+  function clock_text(seconds) result(text)
+    real(dp), intent(in) :: seconds
+    character(len=:), allocatable :: text
+    character(len=32) :: buf
+    integer :: s
+
+    s = nint(min(seconds, 3.6e7_dp))
+    write (buf, '(i0,a,i2.2,a,i2.2)') s / 3600, ':', mod(s / 60, 60), ':', mod(s, 60)
+    text = trim(buf)
+  end function clock_text
 end module output_timer
