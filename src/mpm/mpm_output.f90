@@ -24,6 +24,7 @@ module mpm_output
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use output_files, only: file_exists, int_to_str
+  use output_hdf5, only: frame_sequence
   use mpm_particles, only: particle_block_t
   use mpm_grid, only: grid_t
   implicit none
@@ -195,7 +196,7 @@ contains
     integer, intent(in) :: keep
     character(len=:), allocatable, intent(out) :: msg
     integer(hid_t) :: parts, grid, frame
-    integer :: hdferr, storage, n_links, max_corder, f, n_found, ndim(1), n(3), count(1)
+    integer :: hdferr, f, n_found, ndim(1), n(3), count(1)
     real(dp) :: lo(3), h(1), time(1)
     character(len=6) :: tag
     character(len=96) :: text
@@ -238,23 +239,9 @@ contains
     end if
     call h5gopen_f(wr%file, 'particles', parts, hdferr)
     call check(hdferr, 'opening /particles')
-    call h5gget_info_f(parts, storage, n_links, max_corder, hdferr)
-    call check(hdferr, 'h5gget_info /particles')
-    n_found = 0
-    do f = 0, n_links - 1
-       write (tag, '(i6.6)') f
-       call h5lexists_f(parts, tag, exists, hdferr)
-       if (.not. exists) exit
-       n_found = n_found + 1
-    end do
-    if (n_found /= n_links) then
-       msg = 'cannot restart: /particles holds ' // int_to_str(n_links) // ' entries but its frames ' // &
-            '000000.. are not numbered consecutively'
-    else if (n_found < keep) then
-       msg = 'cannot restart at frame ' // int_to_str(keep) // ': the file holds only ' // &
-            int_to_str(n_found) // ' frames'
-    end if
+    call frame_sequence(parts, '/particles', keep, n_found, msg)
     if (allocated(msg)) then
+       if (index(msg, 'cannot restart') /= 1) msg = 'cannot restart: ' // msg
        call h5gclose_f(parts, hdferr)
        call h5gclose_f(grid, hdferr)
        return

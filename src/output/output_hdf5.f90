@@ -47,7 +47,7 @@ module output_hdf5
   public :: field_writer_t
   public :: field_writer_open, field_writer_frame, field_writer_end_frame
   public :: field_writer_coordinates, field_writer_node_field, field_writer_element_field
-  public :: field_writer_close, field_writer_frame_count
+  public :: field_writer_close, field_writer_frame_count, frame_sequence
 
   integer, parameter :: format_version = 1
   !> The file named in messages of failed HDF5 calls (set by each public procedure): such
@@ -515,7 +515,6 @@ contains
     character(len=256) :: link_name
     character(len=4) :: center
     character(len=6) :: tag
-    logical :: exists
     real(dp) :: time
 
     call dataset_dims('/mesh/coordinates', nd, dims)
@@ -533,22 +532,7 @@ contains
 
     call h5gopen_f(w%file, '/frames', group, hdferr)
     call check(hdferr, 'opening /frames')
-    call h5gget_info_f(group, storage, n_links, max_corder, hdferr)
-    call check(hdferr, 'h5gget_info /frames')
-    n_found = 0
-    do f = 0, n_links - 1
-       write (tag, '(i6.6)') f
-       call h5lexists_f(group, tag, exists, hdferr)
-       if (.not. exists) exit
-       n_found = n_found + 1
-    end do
-    if (n_found /= n_links) then
-       msg = '/frames holds ' // int_to_str(n_links) // ' entries but frames 000000.. are ' // &
-            'not numbered consecutively'
-    else if (n_found < keep) then
-       msg = 'cannot restart at frame ' // int_to_str(keep) // ': the file holds only ' // &
-            int_to_str(n_found) // ' frames'
-    end if
+    call frame_sequence(group, '/frames', keep, n_found, msg)
     if (allocated(msg)) then
        call h5gclose_f(group, hdferr)
        return
@@ -615,6 +599,37 @@ contains
     end subroutine dataset_dims
 
   end subroutine reopen_frames
+
+  !> The frames 000000, 000001, ... of an output group (where: its path, for the message) that a
+  !> restart reopens to keep the first `keep`: n_found of them; msg is allocated when they are
+  !> not numbered consecutively or fewer than keep.
+  subroutine frame_sequence(group, where, keep, n_found, msg)
+    integer(hid_t), intent(in) :: group
+    character(len=*), intent(in) :: where
+    integer, intent(in) :: keep
+    integer, intent(out) :: n_found
+    character(len=:), allocatable, intent(inout) :: msg
+    integer :: hdferr, storage, n_links, max_corder, f
+    character(len=6) :: tag
+    logical :: exists
+
+    call h5gget_info_f(group, storage, n_links, max_corder, hdferr)
+    call check(hdferr, 'h5gget_info ' // where)
+    n_found = 0
+    do f = 0, n_links - 1
+       write (tag, '(i6.6)') f
+       call h5lexists_f(group, tag, exists, hdferr)
+       if (.not. exists) exit
+       n_found = n_found + 1
+    end do
+    if (n_found /= n_links) then
+       msg = where // ' holds ' // int_to_str(n_links) // ' entries but its frames 000000.. are ' // &
+            'not numbered consecutively'
+    else if (n_found < keep) then
+       msg = 'cannot restart at frame ' // int_to_str(keep) // ': the file holds only ' // &
+            int_to_str(n_found) // ' frames'
+    end if
+  end subroutine frame_sequence
 
   !> Rank and dimensions (Fortran order, at most 2) of a dataset.
   subroutine dataset_space(dset, ndims, dims)
