@@ -1,7 +1,8 @@
 !> The element phase of an increment, block by block: kinematics on the mid-increment
 !> configuration, corotational strain increment, [VUSDFLD] + VUMAT, stress back to the global
 !> frame, bulk viscosity, internal and hourglass forces, element stable increment and energies.
-!> Each block writes its element forces into solver%fe for the deterministic assembly.
+!> Each block's element forces are assembled into solver%f_int as soon as the block is done
+!> (parallel_assembly's block form: the same sums as the one-call assembly, in cache).
 module driver_elements
   use material_kinds, only: dp
   use error_report, only: raise_error
@@ -9,7 +10,7 @@ module driver_elements
   use model_mesh, only: element_cpe4r
   use driver_solver, only: solver_t, element_block_t
   use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
-       effect_bulk_viscosity, effect_user_field
+       effect_bulk_viscosity, effect_user_field, effect_assembly
   use driver_vumat_call, only: vumat_work_t, call_material, vumat_work_init
   use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_internal_force_bv, &
        cpe4r_hourglass_update
@@ -18,6 +19,9 @@ module driver_elements
        vumat_stretch
   use fem_bulk_viscosity, only: bulk_viscosity
   use driver_plastic_strain, only: add_elastic_compliance
+  use parallel_partition, only: partition_t
+  use parallel_assembly, only: block_assembly_t, block_assembly_init, assembly_start, &
+       assembly_add_block, assembly_finish
   use fem_stable_dt, only: element_stable_dt
   use fem_inversion, only: check_inversion, inversion_reason_text, default_min_volume_ratio
   use fem_hourglass, only: hourglass_viscous, default_hourglass_viscous_coefficient, &
@@ -52,6 +56,7 @@ module driver_elements
   type, public :: element_workspace_t
      integer :: ndim = 0, nen = 0, ncomp = 0, nshr = 0, nstatev = 1, nfieldv = 1
      type(element_work_t), allocatable :: sets(:)
+     type(block_assembly_t) :: assembly               !< f_int block by block
   end type element_workspace_t
 
   public :: element_work_init, element_workspace_init, element_phase
@@ -86,8 +91,9 @@ contains
     w%e_hg = 0
   end subroutine element_work_init
 
-  subroutine element_workspace_init(ws, ndim, nen, ncomp, nshr, nstatev, nfieldv)
+  subroutine element_workspace_init(ws, part, ndim, nen, ncomp, nshr, nstatev, nfieldv)
     type(element_workspace_t), intent(out) :: ws
+    type(partition_t), intent(in) :: part
     integer, intent(in) :: ndim, nen, ncomp, nshr, nstatev, nfieldv
 
     ws%ndim = ndim
@@ -97,6 +103,7 @@ contains
     ws%nstatev = nstatev
     ws%nfieldv = nfieldv
     allocate(ws%sets(0))
+    call block_assembly_init(part, ndim, ws%assembly)
   end subroutine element_workspace_init
 
   !> Index of the work set of exactly nb elements, made when first needed.
@@ -117,7 +124,8 @@ contains
   end function work_set
 
   !> All blocks of this rank for one increment, from the nodal x_old = x0 + u_n and
-  !> du = solver%du = dt v_{n+1/2}. Sets solver%fe, the element energies, and returns the smallest
+  !> du = solver%du = dt v_{n+1/2}. Sets solver%f_int (assembled; collective over the
+  !> neighbouring ranks), the element energies, and returns the smallest
   !> element stable increment (unscaled) with the user number of its element. Stops with the
   !> element number, the time and the reason when an element inverts or collapses.
   !> x0 + u is formed per gathered node (the same sum as the nodal array x0 + u it replaces:
@@ -131,7 +139,6 @@ contains
     real(dp), intent(out) :: dt_min
     integer, intent(out) :: dt_elem
     integer :: ib, nb, e, nd, ne, iw
-    logical :: fe_written
 
     dt_min = huge(1.0_dp)
     dt_elem = 0
@@ -139,6 +146,7 @@ contains
     ne = solver%nen
     ! The 'elements' timer runs except while a nested effect (material, hourglass, ...) has its
     ! own, so the shares in the report add up to the wall time.
+    call assembly_start(solver%f_int)
     call effects%start(effect_elements)
     do ib = 1, solver%n_blocks
        iw = work_set(ws, solver%blocks(ib)%count)
@@ -151,17 +159,24 @@ contains
             call gather_block(nb, nd, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
                  solver%u, solver%du, w%xe_old, w%du, w%xe_mid, w%xe_new)
          end if
-         call block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2, fe_written)
+         call block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
          do e = 1, nb
             if (w%dt_el(e) < dt_min) then
                dt_min = w%dt_el(e)
                dt_elem = blk%elem_number(e)
             end if
          end do
-         if (.not. fe_written) solver%fe(blk%first:blk%first + nb - 1, :, :) = w%fe(1:nb, :, :)
+         call effects%stop(effect_elements)
+         call effects%start(effect_assembly)
+         call assembly_add_block(solver%part, ws%assembly, blk%first, nb, w%fe, solver%f_int)
+         call effects%stop(effect_assembly)
+         call effects%start(effect_elements)
        end associate
     end do
     call effects%stop(effect_elements)
+    call effects%start(effect_assembly)
+    call assembly_finish(solver%part, ws%assembly, solver%f_int)
+    call effects%stop(effect_assembly)
   end subroutine element_phase
 
   !> Element coordinates x_n = x0 + u_n, x_{n+½}, x_{n+1} and du of a block from the nodal arrays,
@@ -218,9 +233,8 @@ contains
     end do
   end subroutine gather_block_2d
 
-  !> One block's increment. fe_written: the element forces are already in solver%fe (the
-  !> CPE4R hourglass kernel writes them there), else they are in w%fe.
-  subroutine block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2, fe_written)
+  !> One block's increment; the element forces end in w%fe.
+  subroutine block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
     type(element_block_t), intent(inout) :: blk
@@ -228,7 +242,6 @@ contains
     type(element_work_t), intent(inout) :: w
     integer, intent(in) :: nb, nd, ne
     real(dp), intent(in) :: dt, b1, b2
-    logical, intent(out) :: fe_written
     integer :: e, nc, ns, a, i, hourglass_kind
     real(dp) :: hourglass_coefficient
     character(len=64) :: text
@@ -236,7 +249,6 @@ contains
 
     nc = solver%ncomp
     ns = solver%nshr
-    fe_written = .false.
     plane = m%mesh%element_type == element_cpe4r
     if (plane) then
        ! Kinematics, inversion check, corotational step and density in one pass.
@@ -376,12 +388,9 @@ contains
        ! hourglass forces make; blk%force_hg keeps it for the next increment.
        if (plane) then
           ! One fused kernel: forces, force change and work in one pass over the block.
-          ! The forces go straight into the solver's element array.
           call cpe4r_hourglass_update(nb, blk%thickness, w%gamma, w%bsq, w%volume_mid, w%du, &
                dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, blk%rotation, &
-               blk%hourglass, w%fe, size(solver%fe, 1), blk%first, solver%fe, blk%force_hg, &
-               w%e_hg_kernel, w%e_hg)
-          fe_written = .true.
+               blk%hourglass, w%fe, blk%force_hg, w%e_hg_kernel, w%e_hg)
        else
           w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)
           call c3d8r_hourglass(nb, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), &

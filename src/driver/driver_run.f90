@@ -10,7 +10,7 @@ module driver_run
   use model, only: model_t
   use model_mesh, only: element_cpe4r
   use parallel_partition, only: partition_t, partition_model
-  use parallel_assembly, only: assemble_element_vectors, global_min, global_sum
+  use parallel_assembly, only: global_min, global_sum
   use driver_solver, only: solver_t
   use driver_effects, only: effects_t, effect_gravity, effect_rigid_walls, effect_boundary, &
        effect_assembly, effect_output, effect_checkpoint, effect_user_field
@@ -77,7 +77,7 @@ contains
        max_state = max(max_state, m%materials(i)%nstatev)
        max_field = max(max_field, m%materials(i)%nfieldv)
     end do
-    call element_workspace_init(ew, solver%ndim, solver%nen, solver%ncomp, solver%nshr, max_state, max_field)
+    call element_workspace_init(ew, solver%part, solver%ndim, solver%nen, solver%ncomp, solver%nshr, max_state, max_field)
 
     first_step = 1
     resumed = .false.
@@ -226,9 +226,6 @@ contains
          solver%rigid(i)%u = solver%rigid(i)%u + dt * solver%rigid(i)%v
       end do
 
-      call effects%start(effect_assembly)
-      call assemble_element_vectors(solver%part, solver%ndim, solver%fe, solver%f_int)
-      call effects%stop(effect_assembly)
       ! Gravity without an amplitude is the same at every time of the step: f_ext (set at the
       ! step start, or read from the checkpoint) stays, and f_ext_old is f_ext. Recomputing it
       ! gave the same numbers at the cost of two passes over the nodes. (Code that changes the

@@ -6,7 +6,8 @@ module driver_setup
   use model, only: model_t
   use model_mesh, only: element_cpe4r
   use parallel_partition, only: partition_t, local_node_index, local_elem_index
-  use parallel_assembly, only: assemble_element_vectors
+  use parallel_assembly, only: assemble_element_vectors, block_assembly_t, block_assembly_init, &
+       assembly_start, assembly_add_block, assembly_finish
   use driver_solver, only: solver_t, element_block_t, build_blocks
   use driver_vumat_call, only: packaging_modulus
   use fem_cpe4r, only: cpe4r_geometry, cpe4r_internal_force
@@ -39,7 +40,6 @@ contains
     allocate(solver%mass(nn), solver%f_int(nd, nn), solver%f_ext(nd, nn), solver%f_contact(nd, nn))
     allocate(solver%reaction(nd, nn), solver%fixed(nd, nn))
     allocate(solver%du(nd, nn), solver%f_ext_old(nd, nn), solver%v_old(nd, nn))
-    allocate(solver%fe(part%n_local_elems, nd, solver%nen))
     do i = 1, nn
        solver%x0(:, i) = m%mesh%x0(:, part%node_global(i))
     end do
@@ -197,7 +197,10 @@ contains
     type(solver_t), intent(inout) :: solver
     integer :: ib, nb
     real(dp), allocatable :: fe(:, :, :)
+    type(block_assembly_t) :: ba
 
+    call block_assembly_init(solver%part, solver%ndim, ba)
+    call assembly_start(solver%f_int)
     do ib = 1, solver%n_blocks
        associate (blk => solver%blocks(ib))
          nb = blk%count
@@ -207,11 +210,11 @@ contains
          else
             call c3d8r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, fe)
          end if
-         solver%fe(blk%first:blk%first + nb - 1, :, :) = fe
+         call assembly_add_block(solver%part, ba, blk%first, nb, fe, solver%f_int)
          deallocate(fe)
        end associate
     end do
-    call assemble_element_vectors(solver%part, solver%ndim, solver%fe, solver%f_int)
+    call assembly_finish(solver%part, ba, solver%f_int)
   end subroutine initial_internal_forces
 
   !> Does any step write the element field `name` (LE, PE)?

@@ -68,7 +68,6 @@ module driver_solver
      !> v_free = v_{n-1/2} + Δt_avg a_n the unconstrained v_{n+1/2}, and their work uses both
      !> (constraint_work forms v_free again from v_old and a: no array of its own).
      real(dp), allocatable :: v_old(:, :)
-     real(dp), allocatable :: fe(:, :, :)             !< (n_local_elems, ndim, nen) element forces
      integer :: n_blocks = 0
      type(element_block_t), allocatable :: blocks(:)
      type(rigid_body_t), allocatable :: rigid(:)      !< one per rigid surface

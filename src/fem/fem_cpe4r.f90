@@ -318,11 +318,11 @@ contains
     real(dp), intent(inout) :: hg_state(nb, 2, 1)
     real(dp), intent(inout) :: fe(nb, 2, 4)
     real(dp), intent(out) :: energy_inc(nb)
-    real(dp), allocatable :: force_hg(:, :, :), work(:), gamma(:, :, :), bsq(:), fe_in(:, :, :)
+    real(dp), allocatable :: force_hg(:, :, :), work(:), gamma(:, :, :), bsq(:)
     integer :: n, i
 
     ! Not on the solver's path (tests, single elements): the extra arrays may be allocated.
-    allocate(force_hg(nb, 2, 4), work(nb), gamma(nb, 4, 1), bsq(nb), fe_in(nb, 2, 4))
+    allocate(force_hg(nb, 2, 4), work(nb), gamma(nb, 4, 1), bsq(nb))
     force_hg = 0.0_dp
     ! γ and Σ B² as cpe4r_increment_kinematics forms them
     call cpe4r_hourglass_gamma(nb, xe_mid, bmat_mid, gamma)
@@ -332,20 +332,15 @@ contains
           bsq = bsq + bmat_mid(:, i, n)**2
        end do
     end do
-    fe_in = fe
     call cpe4r_hourglass_update(nb, thickness, gamma(:, :, 1), bsq, volume_mid, du, dt, density, &
-         modulus, kind, coefficient, rot_mid, rot_new, hg_state, fe_in, nb, 1, fe, force_hg, &
-         energy_inc, work)
+         modulus, kind, coefficient, rot_mid, rot_new, hg_state, fe, force_hg, energy_inc, work)
   end subroutine cpe4r_hourglass
 
   !> cpe4r_hourglass as the solver uses it: one element loop on scalars (no block temporaries,
   !> every element read once), which also books the hourglass work.
   !> gamma (nb, 4): γ of x_{n+½}; bsq (nb): Σ_iI B_iI² of B_{n+½} (read by the stiffness form
   !> only); both from cpe4r_increment_kinematics, in place of x_{n+½} and B_{n+½}.
-  !> fe_in (nb, 2, 4): the block's forces without hourglass; fe_out: the solver's element force
-  !> array of n_out elements, whose elements first .. first+nb−1 receive fe_in + the hourglass
-  !> forces. (Written there directly: the driver's copy of the block's forces into the solver's
-  !> array was a pass of its own.)
+  !> fe (nb, 2, 4): in, the block's forces without hourglass; out, with the hourglass forces.
   !> force_hg (nb, 2, 4): in, the hourglass forces of the element at t_n; out, those at t_{n+1},
   !> taken as the change of fe they make (fe_after − fe_before: the forces the assembly sees).
   !> work (nb): ½ Σ_iI (f_n + f_{n+1})_iI du_iI, the trapezoidal work of the hourglass forces
@@ -354,7 +349,7 @@ contains
   !> hourglass_forces and the driver's former separate work loop, so results are bitwise the same.
   pure subroutine cpe4r_hourglass_update(nb, thickness, gamma, bsq, volume_mid, du, dt, density, &
                                          modulus, kind, coefficient, rot_mid, rot_new, hg_state, &
-                                         fe_in, n_out, first, fe_out, force_hg, energy_inc, work)
+                                         fe, force_hg, energy_inc, work)
     integer, intent(in) :: nb
     real(dp), intent(in) :: thickness(nb)
     real(dp), intent(in) :: gamma(nb, 4), bsq(nb), volume_mid(nb)
@@ -364,14 +359,12 @@ contains
     real(dp), intent(in) :: coefficient
     real(dp), intent(in) :: rot_mid(nb, 2, 2), rot_new(nb, 2, 2)
     real(dp), intent(inout) :: hg_state(nb, 2, 1)
-    real(dp), intent(in) :: fe_in(nb, 2, 4)
-    integer, intent(in) :: n_out, first
-    real(dp), intent(inout) :: fe_out(n_out, 2, 4)
+    real(dp), intent(inout) :: fe(nb, 2, 4)
     real(dp), intent(inout) :: force_hg(nb, 2, 4)
     real(dp), intent(out) :: energy_inc(nb), work(nb)
     real(dp) :: g1, g2, g3, g4, q1, q2, qc1, qc2, h1, h2, qg1, qg2, area, scale, c, dtm
     real(dp) :: f_old, f_new, df, w
-    integer :: e, o
+    integer :: e
 
     dtm = max(dt, tiny(1.0_dp))
     if (kind == hourglass_viscous) then
@@ -380,7 +373,6 @@ contains
        ! this many arrays exceed its limit, and it then left the loop scalar.)
        !GCC$ ivdep
        do e = 1, nb
-          o = first + e - 1
           ! γ_I = h_I − (h·x) B_xI − (h·y) B_yI (cpe4r_hourglass_gamma)
           g1 = gamma(e, 1)
           g2 = gamma(e, 2)
@@ -398,21 +390,21 @@ contains
           energy_inc(e) = (0.0_dp + qg1 * q1) + qg2 * q2
           ! f_iI += qg_i γ_I; the force change and its trapezoidal work, node by node, i inner
           w = 0.0_dp
-          f_old = fe_in(e, 1, 1); f_new = f_old + qg1 * g1; fe_out(o, 1, 1) = f_new; df = f_new - f_old
+          f_old = fe(e, 1, 1); f_new = f_old + qg1 * g1; fe(e, 1, 1) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 1, 1) + df) * du(e, 1, 1); force_hg(e, 1, 1) = df
-          f_old = fe_in(e, 2, 1); f_new = f_old + qg2 * g1; fe_out(o, 2, 1) = f_new; df = f_new - f_old
+          f_old = fe(e, 2, 1); f_new = f_old + qg2 * g1; fe(e, 2, 1) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 2, 1) + df) * du(e, 2, 1); force_hg(e, 2, 1) = df
-          f_old = fe_in(e, 1, 2); f_new = f_old + qg1 * g2; fe_out(o, 1, 2) = f_new; df = f_new - f_old
+          f_old = fe(e, 1, 2); f_new = f_old + qg1 * g2; fe(e, 1, 2) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 1, 2) + df) * du(e, 1, 2); force_hg(e, 1, 2) = df
-          f_old = fe_in(e, 2, 2); f_new = f_old + qg2 * g2; fe_out(o, 2, 2) = f_new; df = f_new - f_old
+          f_old = fe(e, 2, 2); f_new = f_old + qg2 * g2; fe(e, 2, 2) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 2, 2) + df) * du(e, 2, 2); force_hg(e, 2, 2) = df
-          f_old = fe_in(e, 1, 3); f_new = f_old + qg1 * g3; fe_out(o, 1, 3) = f_new; df = f_new - f_old
+          f_old = fe(e, 1, 3); f_new = f_old + qg1 * g3; fe(e, 1, 3) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 1, 3) + df) * du(e, 1, 3); force_hg(e, 1, 3) = df
-          f_old = fe_in(e, 2, 3); f_new = f_old + qg2 * g3; fe_out(o, 2, 3) = f_new; df = f_new - f_old
+          f_old = fe(e, 2, 3); f_new = f_old + qg2 * g3; fe(e, 2, 3) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 2, 3) + df) * du(e, 2, 3); force_hg(e, 2, 3) = df
-          f_old = fe_in(e, 1, 4); f_new = f_old + qg1 * g4; fe_out(o, 1, 4) = f_new; df = f_new - f_old
+          f_old = fe(e, 1, 4); f_new = f_old + qg1 * g4; fe(e, 1, 4) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 1, 4) + df) * du(e, 1, 4); force_hg(e, 1, 4) = df
-          f_old = fe_in(e, 2, 4); f_new = f_old + qg2 * g4; fe_out(o, 2, 4) = f_new; df = f_new - f_old
+          f_old = fe(e, 2, 4); f_new = f_old + qg2 * g4; fe(e, 2, 4) = f_new; df = f_new - f_old
           w = w + 0.5_dp * (force_hg(e, 2, 4) + df) * du(e, 2, 4); force_hg(e, 2, 4) = df
           work(e) = w
        end do
@@ -421,7 +413,6 @@ contains
 
     ! Stiffness form, or none: the same steps with the generalised force of that form.
     do e = 1, nb
-       o = first + e - 1
        g1 = gamma(e, 1)
        g2 = gamma(e, 2)
        g3 = gamma(e, 3)
@@ -451,21 +442,21 @@ contains
           energy_inc(e) = 0.0_dp
        end if
        w = 0.0_dp
-       f_old = fe_in(e, 1, 1); f_new = f_old + qg1 * g1; fe_out(o, 1, 1) = f_new; df = f_new - f_old
+       f_old = fe(e, 1, 1); f_new = f_old + qg1 * g1; fe(e, 1, 1) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 1, 1) + df) * du(e, 1, 1); force_hg(e, 1, 1) = df
-       f_old = fe_in(e, 2, 1); f_new = f_old + qg2 * g1; fe_out(o, 2, 1) = f_new; df = f_new - f_old
+       f_old = fe(e, 2, 1); f_new = f_old + qg2 * g1; fe(e, 2, 1) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 2, 1) + df) * du(e, 2, 1); force_hg(e, 2, 1) = df
-       f_old = fe_in(e, 1, 2); f_new = f_old + qg1 * g2; fe_out(o, 1, 2) = f_new; df = f_new - f_old
+       f_old = fe(e, 1, 2); f_new = f_old + qg1 * g2; fe(e, 1, 2) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 1, 2) + df) * du(e, 1, 2); force_hg(e, 1, 2) = df
-       f_old = fe_in(e, 2, 2); f_new = f_old + qg2 * g2; fe_out(o, 2, 2) = f_new; df = f_new - f_old
+       f_old = fe(e, 2, 2); f_new = f_old + qg2 * g2; fe(e, 2, 2) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 2, 2) + df) * du(e, 2, 2); force_hg(e, 2, 2) = df
-       f_old = fe_in(e, 1, 3); f_new = f_old + qg1 * g3; fe_out(o, 1, 3) = f_new; df = f_new - f_old
+       f_old = fe(e, 1, 3); f_new = f_old + qg1 * g3; fe(e, 1, 3) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 1, 3) + df) * du(e, 1, 3); force_hg(e, 1, 3) = df
-       f_old = fe_in(e, 2, 3); f_new = f_old + qg2 * g3; fe_out(o, 2, 3) = f_new; df = f_new - f_old
+       f_old = fe(e, 2, 3); f_new = f_old + qg2 * g3; fe(e, 2, 3) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 2, 3) + df) * du(e, 2, 3); force_hg(e, 2, 3) = df
-       f_old = fe_in(e, 1, 4); f_new = f_old + qg1 * g4; fe_out(o, 1, 4) = f_new; df = f_new - f_old
+       f_old = fe(e, 1, 4); f_new = f_old + qg1 * g4; fe(e, 1, 4) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 1, 4) + df) * du(e, 1, 4); force_hg(e, 1, 4) = df
-       f_old = fe_in(e, 2, 4); f_new = f_old + qg2 * g4; fe_out(o, 2, 4) = f_new; df = f_new - f_old
+       f_old = fe(e, 2, 4); f_new = f_old + qg2 * g4; fe(e, 2, 4) = f_new; df = f_new - f_old
        w = w + 0.5_dp * (force_hg(e, 2, 4) + df) * du(e, 2, 4); force_hg(e, 2, 4) = df
        work(e) = w
     end do
