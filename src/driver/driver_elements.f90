@@ -124,7 +124,7 @@ contains
   end function work_set
 
   !> All blocks of this rank for one increment, from the nodal x_old = x0 + u_n and
-  !> du = solver%du = dt v_{n+1/2}. Sets solver%f_int (assembled; collective over the
+  !> du = dt v_{n+1/2} (formed per gathered node, as finish_nodes forms it: no nodal array). Sets solver%f_int (assembled; collective over the
   !> neighbouring ranks), the element energies, and returns the smallest
   !> element stable increment (unscaled) with the user number of its element. Stops with the
   !> element number, the time and the reason when an element inverts or collapses.
@@ -154,10 +154,10 @@ contains
          nb = blk%count
          if (nd == 2) then
             call gather_block_2d(nb, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
-                 solver%u, solver%du, w%xe_old, w%du)
+                 solver%u, dt, solver%v, w%xe_old, w%du)
          else
             call gather_block(nb, nd, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
-                 solver%u, solver%du, w%xe_old, w%du, w%xe_mid, w%xe_new)
+                 solver%u, dt, solver%v, w%xe_old, w%du, w%xe_mid, w%xe_new)
          end if
          call block_increment(m, solver, blk, effects, w, nb, nd, ne, dt, b1, b2)
          do e = 1, nb
@@ -182,10 +182,10 @@ contains
   !> Element coordinates x_n = x0 + u_n, x_{n+½}, x_{n+1} and du of a block from the nodal arrays,
   !> in one pass. A subroutine with explicit-shape dummies: written in place on the work set's
   !> allocatable components, the loop reloaded their descriptors at every store.
-  subroutine gather_block(nb, nd, ne, conn, x0, u, du_nodes, xe_old, du, xe_mid, xe_new)
+  subroutine gather_block(nb, nd, ne, conn, x0, u, dt, v, xe_old, du, xe_mid, xe_new)
     integer, intent(in) :: nb, nd, ne
     integer, intent(in) :: conn(ne, nb)
-    real(dp), intent(in) :: x0(nd, *), u(nd, *), du_nodes(nd, *)
+    real(dp), intent(in) :: x0(nd, *), u(nd, *), dt, v(nd, *)
     real(dp), intent(out) :: xe_old(nb, nd, ne), du(nb, nd, ne), xe_mid(nb, nd, ne), xe_new(nb, nd, ne)
     integer :: e, i, a, k
     real(dp) :: xo, d
@@ -197,7 +197,7 @@ contains
           k = conn(a, e)
           do i = 1, nd
              xo = x0(i, k) + u(i, k)
-             d = du_nodes(i, k)
+             d = dt * v(i, k)
              xe_old(e, i, a) = xo
              du(e, i, a) = d
              xe_mid(e, i, a) = xo + 0.5_dp * d
@@ -210,10 +210,10 @@ contains
   !> gather_block for two components (CPE4R): x_n and du only. cpe4r_increment_kinematics forms
   !> x_{n+½} and x_{n+1} from them in registers, with the expressions of gather_block (writing
   !> and reading back two more (nb, 2, 4) arrays per block cost more than the additions).
-  subroutine gather_block_2d(nb, ne, conn, x0, u, du_nodes, xe_old, du)
+  subroutine gather_block_2d(nb, ne, conn, x0, u, dt, v, xe_old, du)
     integer, intent(in) :: nb, ne
     integer, intent(in) :: conn(ne, nb)
-    real(dp), intent(in) :: x0(2, *), u(2, *), du_nodes(2, *)
+    real(dp), intent(in) :: x0(2, *), u(2, *), dt, v(2, *)
     real(dp), intent(out) :: xe_old(nb, 2, ne), du(nb, 2, ne)
     integer :: e, a, k
     real(dp) :: xo1, xo2, d1, d2
@@ -223,8 +223,8 @@ contains
           k = conn(a, e)
           xo1 = x0(1, k) + u(1, k)
           xo2 = x0(2, k) + u(2, k)
-          d1 = du_nodes(1, k)
-          d2 = du_nodes(2, k)
+          d1 = dt * v(1, k)
+          d2 = dt * v(2, k)
           xe_old(e, 1, a) = xo1
           xe_old(e, 2, a) = xo2
           du(e, 1, a) = d1

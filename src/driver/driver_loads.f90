@@ -37,6 +37,10 @@ module driver_loads
      type(prescribed_t), allocatable :: prescribed(:), rigid(:)
      type(gravity_local_t), allocatable :: gravity(:)
      type(contact_local_t), allocatable :: contact(:)
+     !> Owned nodes whose velocity a constraint of the step may change after the free update
+     !> (a prescribed dof, or a slave node of a contact pair), ascending: the only nodes with a
+     !> constraint impulse (driver_run's constraint_work).
+     integer, allocatable :: constrained(:)
   end type step_loads_t
 
   public :: prepare_step, apply_prescribed_velocities, apply_rigid_body_velocities, gravity_forces, &
@@ -139,8 +143,27 @@ contains
       end if
       ! Contact forces are zero except at this step's slave nodes (apply_contact resets only those).
       solver%f_contact = 0
+      call constrained_nodes(part, solver%fixed, loads%contact, loads%constrained)
     end associate
   end subroutine prepare_step
+
+  !> The owned nodes with a prescribed dof or in a contact pair's slave set, ascending, once each.
+  subroutine constrained_nodes(part, fixed, contact, nodes)
+    type(partition_t), intent(in) :: part
+    logical, intent(in) :: fixed(:, :)
+    type(contact_local_t), intent(in) :: contact(:)
+    integer, allocatable, intent(out) :: nodes(:)
+    logical, allocatable :: mark(:)
+    integer :: j, k
+
+    allocate(mark(size(fixed, 2)))
+    mark = any(fixed, dim=1)
+    do j = 1, size(contact)
+       mark(contact(j)%owned) = .true.
+    end do
+    mark = mark .and. part%node_owned
+    nodes = pack([(k, k = 1, size(mark))], mark)
+  end subroutine constrained_nodes
 
   subroutine split_slaves(part, nodes, owned, others)
     type(partition_t), intent(in) :: part

@@ -63,7 +63,7 @@ module driver_solver
      real(dp), allocatable :: mass(:)
      real(dp), allocatable :: f_int(:, :), f_ext(:, :), f_contact(:, :), reaction(:, :)
      logical, allocatable :: fixed(:, :)              !< (ndim, n_nodes) dof prescribed this step
-     real(dp), allocatable :: du(:, :), f_ext_old(:, :)  !< increment work arrays
+     real(dp), allocatable :: f_ext_old(:, :)          !< f_ext at t_n when gravity changes
      !> v_{n-1/2} of the increment: the constraint impulses (supports, walls) are m (v − v_free),
      !> v_free = v_{n-1/2} + Δt_avg a_n the unconstrained v_{n+1/2}, and their work uses both
      !> (constraint_work forms v_free again from v_old and a: no array of its own).
