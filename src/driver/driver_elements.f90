@@ -384,8 +384,9 @@ contains
        ! as the balance charges it (the kernels' C q²/Δt of the viscous form pairs the force of
        ! t_{n+1} with this increment alone; where the rates change fast — a block released from
        ! its initial stress — that lag put 1 % of the energies into ETOTAL). For the stiffness form
-       ! the two agree up to the rotation of the increment. f_{n+1} is the change of fe the
-       ! hourglass forces make; blk%force_hg keeps it for the next increment.
+       ! the two agree up to the rotation of the increment. blk%force_hg keeps f_{n+1} for the
+       ! next increment: C3D8R the change of fe the hourglass forces make, CPE4R its generalised
+       ! force (cpe4r_hourglass_update).
        if (plane) then
           ! One fused kernel: forces, force change and work in one pass over the block.
           call cpe4r_hourglass_update(nb, blk%thickness, w%gamma, w%bsq, w%volume_mid, w%du, &

@@ -141,7 +141,13 @@ contains
       allocate(blk%mass(nb), blk%rotation(nb, nd, nd), blk%hourglass(nb, nd, solver%nmode))
       allocate(blk%stress(nb, solver%ncomp), blk%stress_global(nb, solver%ncomp))
       allocate(blk%state(nb, blk%nstatev), blk%field(nb, blk%nfieldv), blk%e_int(nb), blk%e_inel(nb))
-      allocate(blk%sigma_bv(nb), blk%force_hg(nb, nd, ne))
+      ! Hourglass forces of t_n for the ALLAE work: CPE4R keeps the generalised force Q (nb, 2, 1)
+      ! of its one mode (cpe4r_hourglass_update), C3D8R the nodal forces (nb, 3, 8).
+      if (m%mesh%element_type == element_cpe4r) then
+         allocate(blk%sigma_bv(nb), blk%force_hg(nb, nd, 1))
+      else
+         allocate(blk%sigma_bv(nb), blk%force_hg(nb, nd, ne))
+      end if
       blk%sigma_bv = 0
       blk%force_hg = 0
       ! LE is kept where a VUSDFLD will ask for it, and everywhere when a step writes it (before,

@@ -35,7 +35,9 @@ module driver_solver
      real(dp), allocatable :: log_strain(:, :)        !< accumulated corotational strain (LE)
      real(dp), allocatable :: plastic_strain(:, :)    !< corotational plastic strain (PE); (0, ncomp) unless written
      real(dp), allocatable :: sigma_bv(:)             !< bulk-viscosity pressure of the last increment
-     real(dp), allocatable :: force_hg(:, :, :)       !< (count, ndim, nen) hourglass forces at t_n
+     !> hourglass forces at t_n: C3D8R (count, 3, 8) nodal; CPE4R (count, 2, 1) the generalised
+     !> force of its one mode (fem_cpe4r's cpe4r_hourglass_update)
+     real(dp), allocatable :: force_hg(:, :, :)
      real(dp) :: wave_modulus = 0                     !< λ + 2G from the packaging call
      !> Pass F and U (defgradOld/New, stretchOld/New) to the VUMAT. Our own materials never
      !> read them, so blocks of our materials skip computing them (an effect not asked for).

@@ -322,7 +322,7 @@ contains
     integer :: n, i
 
     ! Not on the solver's path (tests, single elements): the extra arrays may be allocated.
-    allocate(force_hg(nb, 2, 4), work(nb), gamma(nb, 4, 1), bsq(nb))
+    allocate(force_hg(nb, 2, 1), work(nb), gamma(nb, 4, 1), bsq(nb))
     force_hg = 0.0_dp
     ! γ and Σ B² as cpe4r_increment_kinematics forms them
     call cpe4r_hourglass_gamma(nb, xe_mid, bmat_mid, gamma)
@@ -341,12 +341,16 @@ contains
   !> gamma (nb, 4): γ of x_{n+½}; bsq (nb): Σ_iI B_iI² of B_{n+½} (read by the stiffness form
   !> only); both from cpe4r_increment_kinematics, in place of x_{n+½} and B_{n+½}.
   !> fe (nb, 2, 4): in, the block's forces without hourglass; out, with the hourglass forces.
-  !> force_hg (nb, 2, 4): in, the hourglass forces of the element at t_n; out, those at t_{n+1},
-  !> taken as the change of fe they make (fe_after − fe_before: the forces the assembly sees).
-  !> work (nb): ½ Σ_iI (f_n + f_{n+1})_iI du_iI, the trapezoidal work of the hourglass forces
-  !> over the increment, as the energy balance charges it (ALLAE).
-  !> The sums and their order are those of cpe4r_hourglass_gamma, fem_hourglass's
-  !> hourglass_forces and the driver's former separate work loop, so results are bitwise the same.
+  !> force_hg (nb, 2, 1): in, the generalised hourglass force Q_n of t_n (the nodal forces are
+  !> f_iI = Q_i γ_I); out, Q_{n+1}.
+  !> work (nb): ½ (Q_n + Q_{n+1})·q with q_i = Σ_I γ_I du_iI: the trapezoidal work
+  !> ½ Σ_iI (f_n + f_{n+1})_iI du_iI of the hourglass forces over the increment, as the energy
+  !> balance charges it (ALLAE), with f_n taken on this increment's γ — which moves by the order
+  !> of a strain increment per increment. (The eight nodal forces of t_n, kept before, were
+  !> 8 values read and 8 written per element and increment: a sixth of the element loop's
+  !> memory traffic, for a difference in ALLAE at round-off level.)
+  !> The forces and their sums are those of cpe4r_hourglass_gamma and fem_hourglass's
+  !> hourglass_forces, so the forces are bitwise the same.
   pure subroutine cpe4r_hourglass_update(nb, thickness, gamma, bsq, volume_mid, du, dt, density, &
                                          modulus, kind, coefficient, rot_mid, rot_new, hg_state, &
                                          fe, force_hg, energy_inc, work)
@@ -360,10 +364,9 @@ contains
     real(dp), intent(in) :: rot_mid(nb, 2, 2), rot_new(nb, 2, 2)
     real(dp), intent(inout) :: hg_state(nb, 2, 1)
     real(dp), intent(inout) :: fe(nb, 2, 4)
-    real(dp), intent(inout) :: force_hg(nb, 2, 4)
+    real(dp), intent(inout) :: force_hg(nb, 2, 1)
     real(dp), intent(out) :: energy_inc(nb), work(nb)
     real(dp) :: g1, g2, g3, g4, q1, q2, qc1, qc2, h1, h2, qg1, qg2, area, scale, c, dtm
-    real(dp) :: f_old, f_new, df, w
     integer :: e
 
     dtm = max(dt, tiny(1.0_dp))
@@ -388,25 +391,18 @@ contains
           qg1 = c * q1
           qg2 = c * q2
           energy_inc(e) = (0.0_dp + qg1 * q1) + qg2 * q2
-          ! f_iI += qg_i γ_I; the force change and its trapezoidal work, node by node, i inner
-          w = 0.0_dp
-          f_old = fe(e, 1, 1); f_new = f_old + qg1 * g1; fe(e, 1, 1) = f_new; df = f_new - f_old
-          w = w + 0.5_dp * (force_hg(e, 1, 1) + df) * du(e, 1, 1); force_hg(e, 1, 1) = df
-          f_old = fe(e, 2, 1); f_new = f_old + qg2 * g1; fe(e, 2, 1) = f_new; df = f_new - f_old
-          w = w + 0.5_dp * (force_hg(e, 2, 1) + df) * du(e, 2, 1); force_hg(e, 2, 1) = df
-          f_old = fe(e, 1, 2); f_new = f_old + qg1 * g2; fe(e, 1, 2) = f_new; df = f_new - f_old
-          w = w + 0.5_dp * (force_hg(e, 1, 2) + df) * du(e, 1, 2); force_hg(e, 1, 2) = df
-          f_old = fe(e, 2, 2); f_new = f_old + qg2 * g2; fe(e, 2, 2) = f_new; df = f_new - f_old
-          w = w + 0.5_dp * (force_hg(e, 2, 2) + df) * du(e, 2, 2); force_hg(e, 2, 2) = df
-          f_old = fe(e, 1, 3); f_new = f_old + qg1 * g3; fe(e, 1, 3) = f_new; df = f_new - f_old
-          w = w + 0.5_dp * (force_hg(e, 1, 3) + df) * du(e, 1, 3); force_hg(e, 1, 3) = df
-          f_old = fe(e, 2, 3); f_new = f_old + qg2 * g3; fe(e, 2, 3) = f_new; df = f_new - f_old
-          w = w + 0.5_dp * (force_hg(e, 2, 3) + df) * du(e, 2, 3); force_hg(e, 2, 3) = df
-          f_old = fe(e, 1, 4); f_new = f_old + qg1 * g4; fe(e, 1, 4) = f_new; df = f_new - f_old
-          w = w + 0.5_dp * (force_hg(e, 1, 4) + df) * du(e, 1, 4); force_hg(e, 1, 4) = df
-          f_old = fe(e, 2, 4); f_new = f_old + qg2 * g4; fe(e, 2, 4) = f_new; df = f_new - f_old
-          w = w + 0.5_dp * (force_hg(e, 2, 4) + df) * du(e, 2, 4); force_hg(e, 2, 4) = df
-          work(e) = w
+          ! f_iI += qg_i γ_I; the trapezoidal work with the generalised forces
+          fe(e, 1, 1) = fe(e, 1, 1) + qg1 * g1
+          fe(e, 2, 1) = fe(e, 2, 1) + qg2 * g1
+          fe(e, 1, 2) = fe(e, 1, 2) + qg1 * g2
+          fe(e, 2, 2) = fe(e, 2, 2) + qg2 * g2
+          fe(e, 1, 3) = fe(e, 1, 3) + qg1 * g3
+          fe(e, 2, 3) = fe(e, 2, 3) + qg2 * g3
+          fe(e, 1, 4) = fe(e, 1, 4) + qg1 * g4
+          fe(e, 2, 4) = fe(e, 2, 4) + qg2 * g4
+          work(e) = 0.5_dp * (force_hg(e, 1, 1) + qg1) * q1 + 0.5_dp * (force_hg(e, 2, 1) + qg2) * q2
+          force_hg(e, 1, 1) = qg1
+          force_hg(e, 2, 1) = qg2
        end do
        return
     end if
@@ -441,24 +437,17 @@ contains
           qg2 = 0.0_dp
           energy_inc(e) = 0.0_dp
        end if
-       w = 0.0_dp
-       f_old = fe(e, 1, 1); f_new = f_old + qg1 * g1; fe(e, 1, 1) = f_new; df = f_new - f_old
-       w = w + 0.5_dp * (force_hg(e, 1, 1) + df) * du(e, 1, 1); force_hg(e, 1, 1) = df
-       f_old = fe(e, 2, 1); f_new = f_old + qg2 * g1; fe(e, 2, 1) = f_new; df = f_new - f_old
-       w = w + 0.5_dp * (force_hg(e, 2, 1) + df) * du(e, 2, 1); force_hg(e, 2, 1) = df
-       f_old = fe(e, 1, 2); f_new = f_old + qg1 * g2; fe(e, 1, 2) = f_new; df = f_new - f_old
-       w = w + 0.5_dp * (force_hg(e, 1, 2) + df) * du(e, 1, 2); force_hg(e, 1, 2) = df
-       f_old = fe(e, 2, 2); f_new = f_old + qg2 * g2; fe(e, 2, 2) = f_new; df = f_new - f_old
-       w = w + 0.5_dp * (force_hg(e, 2, 2) + df) * du(e, 2, 2); force_hg(e, 2, 2) = df
-       f_old = fe(e, 1, 3); f_new = f_old + qg1 * g3; fe(e, 1, 3) = f_new; df = f_new - f_old
-       w = w + 0.5_dp * (force_hg(e, 1, 3) + df) * du(e, 1, 3); force_hg(e, 1, 3) = df
-       f_old = fe(e, 2, 3); f_new = f_old + qg2 * g3; fe(e, 2, 3) = f_new; df = f_new - f_old
-       w = w + 0.5_dp * (force_hg(e, 2, 3) + df) * du(e, 2, 3); force_hg(e, 2, 3) = df
-       f_old = fe(e, 1, 4); f_new = f_old + qg1 * g4; fe(e, 1, 4) = f_new; df = f_new - f_old
-       w = w + 0.5_dp * (force_hg(e, 1, 4) + df) * du(e, 1, 4); force_hg(e, 1, 4) = df
-       f_old = fe(e, 2, 4); f_new = f_old + qg2 * g4; fe(e, 2, 4) = f_new; df = f_new - f_old
-       w = w + 0.5_dp * (force_hg(e, 2, 4) + df) * du(e, 2, 4); force_hg(e, 2, 4) = df
-       work(e) = w
+       fe(e, 1, 1) = fe(e, 1, 1) + qg1 * g1
+       fe(e, 2, 1) = fe(e, 2, 1) + qg2 * g1
+       fe(e, 1, 2) = fe(e, 1, 2) + qg1 * g2
+       fe(e, 2, 2) = fe(e, 2, 2) + qg2 * g2
+       fe(e, 1, 3) = fe(e, 1, 3) + qg1 * g3
+       fe(e, 2, 3) = fe(e, 2, 3) + qg2 * g3
+       fe(e, 1, 4) = fe(e, 1, 4) + qg1 * g4
+       fe(e, 2, 4) = fe(e, 2, 4) + qg2 * g4
+       work(e) = 0.5_dp * (force_hg(e, 1, 1) + qg1) * q1 + 0.5_dp * (force_hg(e, 2, 1) + qg2) * q2
+       force_hg(e, 1, 1) = qg1
+       force_hg(e, 2, 1) = qg2
     end do
   end subroutine cpe4r_hourglass_update
   !> Area A, volume t·A and mean gradient B of one element from its node coordinates (the
