@@ -43,7 +43,7 @@ module driver_elements
      real(dp), allocatable :: rotation_swap(:, :, :)  !< unallocated: holder for the R exchange
      real(dp), allocatable :: sigma_bv_swap(:)        !< unallocated: holder for the σ_bv exchange
      real(dp), allocatable :: stretch_old(:, :), stretch_new(:, :), defgrad_old(:, :), defgrad_new(:, :)
-     real(dp), allocatable :: stress_force(:, :)
+     real(dp), allocatable :: stress_force(:, :), stress_global(:, :)
      integer, allocatable :: reason(:)
      type(vumat_work_t) :: vumat
   end type element_work_t
@@ -75,7 +75,7 @@ contains
     allocate(w%e_hg(nmax), w%dt_el(nmax), w%reason(nmax), w%volume_abs(nmax), w%e_hg_kernel(nmax))
     allocate(w%gamma(nmax, nen), w%bsq(nmax))
     allocate(w%strain_inc(nmax, ncomp), w%spin_inc(nmax, nshr), w%strain_corot(nmax, ncomp))
-    allocate(w%rel_spin(nmax, nshr), w%stress_force(nmax, ncomp))
+    allocate(w%rel_spin(nmax, nshr), w%stress_force(nmax, ncomp), w%stress_global(nmax, ncomp))
     allocate(w%r_mid(nmax, ndim, ndim), w%r_new(nmax, ndim, ndim), w%f_old(nmax, ndim, ndim))
     allocate(w%f_new(nmax, ndim, ndim))
     allocate(w%stretch_old(nmax, ncomp), w%stretch_new(nmax, ncomp))
@@ -324,14 +324,16 @@ contains
     call move_alloc(blk%rotation, w%rotation_swap)
     call move_alloc(w%r_new, blk%rotation)
     call move_alloc(w%rotation_swap, w%r_new)
-    call to_global(nb, nd, nc, blk%rotation, blk%stress, blk%stress_global)
+    ! The global stress of t_{n+1} lives in the work set only (the output forms it again from
+    ! the same R and σ: the same bits); a block array of it was written to memory every increment.
+    call to_global(nb, nd, nc, blk%rotation, blk%stress, w%stress_global)
 
     ! Mass scaling (driver_mass_scaling): wave speed, stable increment, bulk viscosity and
     ! hourglass see the scaled inertia; the VUMAT above got the physical density.
     if (blk%mass_scaled) w%density(1:nb) = w%density(1:nb) * blk%mass_scale
     w%wave_speed(1:nb) = sqrt(blk%wave_modulus / w%density(1:nb))
     ! CPE4R: the internal-force kernel adds σ_bv itself (no stress copy, no three passes adding it).
-    if (.not. plane) w%stress_force(1:nb, :) = blk%stress_global
+    if (.not. plane) w%stress_force(1:nb, :) = w%stress_global
     bulk = effects%active(effect_bulk_viscosity)
     if (.not. bulk) w%xi(1:nb) = 0
     if (bulk) then
@@ -362,9 +364,9 @@ contains
        call effects%start(effect_elements)
     end if
     if (plane .and. bulk) then
-       call cpe4r_internal_force_bv(nb, w%volume_new, w%bmat_new, blk%stress_global, blk%sigma_bv, w%fe)
+       call cpe4r_internal_force_bv(nb, w%volume_new, w%bmat_new, w%stress_global, blk%sigma_bv, w%fe)
     else if (plane) then
-       call cpe4r_internal_force(nb, w%volume_new, w%bmat_new, blk%stress_global, w%fe)
+       call cpe4r_internal_force(nb, w%volume_new, w%bmat_new, w%stress_global, w%fe)
     else
        call c3d8r_internal_force(nb, w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%stress_force(1:nb, :), &
             w%fe(1:nb, :, :))

@@ -256,7 +256,8 @@ contains
        allocate(values(n, solver%ncomp))
        do ib = 1, solver%n_blocks
           associate (b => solver%blocks(ib))
-            values(b%first:b%first + b%count - 1, :) = b%stress_global
+            call to_global(b%count, solver%ndim, solver%ncomp, b%rotation, b%stress, &
+                 values(b%first:b%first + b%count - 1, :))
           end associate
        end do
        call field_writer_element_field(out%fields, 'S', solver%part%elem_global, values)

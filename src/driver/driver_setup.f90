@@ -12,7 +12,7 @@ module driver_setup
   use driver_vumat_call, only: packaging_modulus
   use fem_cpe4r, only: cpe4r_geometry, cpe4r_internal_force
   use fem_c3d8r, only: c3d8r_geometry, c3d8r_internal_force
-  use fem_corotation, only: identity_rotation
+  use fem_corotation, only: identity_rotation, to_global
   use fem_mass, only: lumped_mass
   use material_props, only: model_from_name, model_unknown
   implicit none
@@ -102,7 +102,6 @@ contains
                if (le == 0) cycle
                call locate(solver, le, ib, e)
                solver%blocks(ib)%stress(e, :) = ic%stress(1:solver%ncomp)
-               solver%blocks(ib)%stress_global(e, :) = ic%stress(1:solver%ncomp)
             end do
           end associate
        end do
@@ -139,7 +138,7 @@ contains
       blk%nfieldv = max(1, mat%nfieldv)
       allocate(blk%elem_number(nb), blk%thickness(nb), blk%volume_ref(nb), blk%bmat_ref(nb, nd, ne))
       allocate(blk%mass(nb), blk%rotation(nb, nd, nd), blk%hourglass(nb, nd, solver%nmode))
-      allocate(blk%stress(nb, solver%ncomp), blk%stress_global(nb, solver%ncomp))
+      allocate(blk%stress(nb, solver%ncomp))
       allocate(blk%state(nb, blk%nstatev), blk%field(nb, blk%nfieldv), blk%e_int(nb), blk%e_inel(nb))
       ! Hourglass forces of t_n for the ALLAE work: CPE4R keeps the generalised force Q (nb, 2, 1)
       ! of its one mode (cpe4r_hourglass_update), C3D8R the nodal forces (nb, 3, 8).
@@ -186,7 +185,6 @@ contains
       call identity_rotation(nb, nd, blk%rotation)
       blk%hourglass = 0
       blk%stress = 0
-      blk%stress_global = 0
       blk%state = 0
       blk%field = 0
       blk%e_int = 0
@@ -202,7 +200,7 @@ contains
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
     integer :: ib, nb
-    real(dp), allocatable :: fe(:, :, :)
+    real(dp), allocatable :: fe(:, :, :), stress_global(:, :)
     type(block_assembly_t) :: ba
 
     call block_assembly_init(solver%part, solver%ndim, ba)
@@ -210,14 +208,15 @@ contains
     do ib = 1, solver%n_blocks
        associate (blk => solver%blocks(ib))
          nb = blk%count
-         allocate(fe(nb, solver%ndim, solver%nen))
+         allocate(fe(nb, solver%ndim, solver%nen), stress_global(nb, solver%ncomp))
+         call to_global(nb, solver%ndim, solver%ncomp, blk%rotation, blk%stress, stress_global)
          if (m%mesh%element_type == element_cpe4r) then
-            call cpe4r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, fe)
+            call cpe4r_internal_force(nb, blk%volume_ref, blk%bmat_ref, stress_global, fe)
          else
-            call c3d8r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%stress_global, fe)
+            call c3d8r_internal_force(nb, blk%volume_ref, blk%bmat_ref, stress_global, fe)
          end if
          call assembly_add_block(solver%part, ba, blk%first, nb, fe, solver%f_int)
-         deallocate(fe)
+         deallocate(fe, stress_global)
        end associate
     end do
     call assembly_finish(solver%part, ba, solver%f_int)

@@ -28,7 +28,6 @@ module driver_solver
      real(dp), allocatable :: rotation(:, :, :)       !< (count, ndim, ndim) R at t_n
      real(dp), allocatable :: hourglass(:, :, :)      !< (count, ndim, nmode) stiffness-form state
      real(dp), allocatable :: stress(:, :)            !< corotational Cauchy stress at t_n
-     real(dp), allocatable :: stress_global(:, :)     !< global stress at t_n (output, forces)
      real(dp), allocatable :: state(:, :)             !< (count, nstatev) SDVs at t_n
      real(dp), allocatable :: field(:, :)             !< (count, nfieldv) field variables at t_n
      real(dp), allocatable :: e_int(:), e_inel(:)     !< specific energies (per unit mass)
