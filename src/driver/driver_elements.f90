@@ -32,6 +32,7 @@ module driver_elements
   !> Per-block work arrays of the element phase, sized once for the largest block.
   type, public :: element_work_t
      real(dp), allocatable :: xe_old(:, :, :), du(:, :, :), xe_mid(:, :, :), xe_new(:, :, :)
+     real(dp), allocatable :: xe_ref(:, :, :)         !< CPE4R: X of the nodes (B0, V0 formed again)
      real(dp), allocatable :: bmat_mid(:, :, :), bmat_new(:, :, :), fe(:, :, :), fe_hg(:, :, :)
      real(dp), allocatable :: volume_mid(:), volume_new(:), char_length(:), density(:), modulus(:)
      real(dp), allocatable :: volume_abs(:)           !< |volume_mid| (no temporary per call)
@@ -69,6 +70,7 @@ contains
 
     allocate(w%xe_old(nmax, ndim, nen), w%du(nmax, ndim, nen), w%xe_mid(nmax, ndim, nen))
     allocate(w%xe_new(nmax, ndim, nen), w%bmat_mid(nmax, ndim, nen), w%bmat_new(nmax, ndim, nen))
+    allocate(w%xe_ref(nmax, ndim, nen))
     allocate(w%fe(nmax, ndim, nen), w%fe_hg(nmax, ndim, nen))
     allocate(w%volume_mid(nmax), w%volume_new(nmax), w%char_length(nmax), w%density(nmax))
     allocate(w%modulus(nmax), w%wave_speed(nmax), w%sigma_bv(nmax), w%xi(nmax), w%e_bv(nmax))
@@ -154,7 +156,7 @@ contains
          nb = blk%count
          if (nd == 2) then
             call gather_block_2d(nb, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
-                 solver%u, dt, solver%v, w%xe_old, w%du)
+                 solver%u, dt, solver%v, w%xe_ref, w%xe_old, w%du)
          else
             call gather_block(nb, nd, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
                  solver%u, dt, solver%v, w%xe_old, w%du, w%xe_mid, w%xe_new)
@@ -207,24 +209,28 @@ contains
     end do
   end subroutine gather_block
 
-  !> gather_block for two components (CPE4R): x_n and du only. cpe4r_increment_kinematics forms
+  !> gather_block for two components (CPE4R): X, x_n and du. cpe4r_increment_kinematics forms
   !> x_{n+½} and x_{n+1} from them in registers, with the expressions of gather_block (writing
   !> and reading back two more (nb, 2, 4) arrays per block cost more than the additions).
-  subroutine gather_block_2d(nb, ne, conn, x0, u, dt, v, xe_old, du)
+  subroutine gather_block_2d(nb, ne, conn, x0, u, dt, v, xe_ref, xe_old, du)
     integer, intent(in) :: nb, ne
     integer, intent(in) :: conn(ne, nb)
     real(dp), intent(in) :: x0(2, *), u(2, *), dt, v(2, *)
-    real(dp), intent(out) :: xe_old(nb, 2, ne), du(nb, 2, ne)
+    real(dp), intent(out) :: xe_ref(nb, 2, ne), xe_old(nb, 2, ne), du(nb, 2, ne)
     integer :: e, a, k
-    real(dp) :: xo1, xo2, d1, d2
+    real(dp) :: xr1, xr2, xo1, xo2, d1, d2
 
     do a = 1, ne
        do e = 1, nb
           k = conn(a, e)
-          xo1 = x0(1, k) + u(1, k)
-          xo2 = x0(2, k) + u(2, k)
+          xr1 = x0(1, k)
+          xr2 = x0(2, k)
+          xo1 = xr1 + u(1, k)
+          xo2 = xr2 + u(2, k)
           d1 = dt * v(1, k)
           d2 = dt * v(2, k)
+          xe_ref(e, 1, a) = xr1
+          xe_ref(e, 2, a) = xr2
           xe_old(e, 1, a) = xo1
           xe_old(e, 2, a) = xo2
           du(e, 1, a) = d1
@@ -252,7 +258,7 @@ contains
     plane = m%mesh%element_type == element_cpe4r
     if (plane) then
        ! Kinematics, inversion check, corotational step and density in one pass.
-       call cpe4r_increment_kinematics(nb, blk%thickness, w%xe_old, w%du, blk%bmat_ref, blk%volume_ref, &
+       call cpe4r_increment_kinematics(nb, blk%thickness, w%xe_old, w%du, w%xe_ref, &
             default_min_volume_ratio, blk%mass, blk%rotation, w%volume_mid, w%volume_abs, w%density, &
             w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, w%char_length, w%reason, &
             w%r_mid, w%r_new, w%f_new, w%strain_corot, w%rel_spin)

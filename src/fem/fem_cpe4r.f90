@@ -108,20 +108,23 @@ contains
   !> registers from x_n and du with the gather's expressions. Every quantity is the same
   !> expression, in the same order, as in those routines, so the results are the same to the bit.
   !> xe_old = x_n, du = Δt v_{n+½} (the gather); x_{n+½} = x_n + ½du, x_{n+1} = x_n + du.
-  !> bmat_ref, volume_ref: reference mean gradient and volume; mass: element masses; r_old = R_n.
+  !> xe_ref = the reference coordinates X, from which the reference mean gradient B0 and volume
+  !> are formed again with cpe4r_geometry's expressions (the same bits as the set-up's): the
+  !> gather reads X anyway, and 72 bytes per element and increment of stored B0 and V0 were a
+  !> fifth of what the pass read from memory. mass: element masses; r_old = R_n.
   !> Out: volume_mid, strain_inc (global), volume_new, bmat_new, char_length,
   !> volume_abs = |volume_mid|, density = mass/|volume_mid|, reason (fem_inversion codes,
   !> check_inversion's order of tests), as corotational_increment r_mid, r_new, f_new,
   !> strain_inc_corot, rel_spin, and for cpe4r_hourglass_update, in place of B_{n+½}: gamma
   !> (nb, 4), γ of x_{n+½} (cpe4r_hourglass_gamma), and bsq = Σ_iI B_iI² of B_{n+½} (the
   !> stiffness form's scale, summed in its order).
-  pure subroutine cpe4r_increment_kinematics(nb, thickness, xe_old, du, bmat_ref, volume_ref, &
+  pure subroutine cpe4r_increment_kinematics(nb, thickness, xe_old, du, xe_ref, &
        min_volume_ratio, mass, r_old, volume_mid, volume_abs, density, gamma, bsq, &
        strain_inc, volume_new, bmat_new, char_length, reason, r_mid, r_new, f_new, &
        strain_inc_corot, rel_spin)
     integer, intent(in) :: nb
-    real(dp), intent(in) :: thickness(nb), xe_old(nb, 2, 4), du(nb, 2, 4), bmat_ref(nb, 2, 4)
-    real(dp), intent(in) :: volume_ref(nb), min_volume_ratio, mass(nb), r_old(nb, 2, 2)
+    real(dp), intent(in) :: thickness(nb), xe_old(nb, 2, 4), du(nb, 2, 4), xe_ref(nb, 2, 4)
+    real(dp), intent(in) :: min_volume_ratio, mass(nb), r_old(nb, 2, 2)
     real(dp), intent(out) :: volume_mid(nb), volume_abs(nb), density(nb), gamma(nb, 4), bsq(nb)
     real(dp), intent(out) :: strain_inc(nb, 4), volume_new(nb), bmat_new(nb, 2, 4)
     real(dp), intent(out) :: char_length(nb)
@@ -133,6 +136,7 @@ contains
     real(dp) :: area, vol, jmin, hx, hy
     real(dp) :: b11, b12, b13, b14, b21, b22, b23, b24, l11, l12, l21, l22, spin
     real(dp) :: f11, f21, f12, f22, q11, q12, q21, q22, n11, n12, n21, n22
+    real(dp) :: r11, r12, r13, r14, r21, r22, r23, r24, vol_ref
     integer :: e, r
 
     ! ivdep: the dummies do not alias (Fortran); the compiler's run-time alias checks for this
@@ -156,6 +160,11 @@ contains
        ny2 = xe_old(e, 2, 2) + du(e, 2, 2)
        ny3 = xe_old(e, 2, 3) + du(e, 2, 3)
        ny4 = xe_old(e, 2, 4) + du(e, 2, 4)
+
+       ! reference B0 and V0 (cpe4r_geometry on X, as the set-up formed them)
+       call quad_geometry(xe_ref(e, 1, 1), xe_ref(e, 1, 2), xe_ref(e, 1, 3), xe_ref(e, 1, 4), &
+            xe_ref(e, 2, 1), xe_ref(e, 2, 2), xe_ref(e, 2, 3), xe_ref(e, 2, 4), thickness(e), area, &
+            vol_ref, r11, r12, r13, r14, r21, r22, r23, r24)
 
        ! x_{n+½}: volume and B (cpe4r_geometry), density, γ and Σ B² (cpe4r_hourglass_gamma,
        ! cpe4r_hourglass_update)
@@ -200,23 +209,21 @@ contains
        jmin = min(jmin, 1.0_dp * ((nx4 - nx3) * (ny2 - ny3) - (ny4 - ny3) * (nx2 - nx3)))
        jmin = min(jmin, -1.0_dp * ((nx3 - nx4) * (ny1 - ny4) - (ny3 - ny4) * (nx1 - nx4)))
        r = inversion_none
-       if (vol < min_volume_ratio * volume_ref(e)) r = inversion_collapse
+       if (vol < min_volume_ratio * vol_ref) r = inversion_collapse
        if (jmin <= 0.0_dp) r = inversion_corner
        if (vol <= 0.0_dp) r = inversion_centre
        reason(e) = r
 
        ! corotational_increment_2d: F_{n+½} and R_{n+½}, F_{n+1} and R_{n+1}
        call plane_defgrad(mx2 - mx1, mx3 - mx1, mx4 - mx1, my2 - my1, my3 - my1, my4 - my1, &
-            bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
-            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
+            r12, r13, r14, r22, r23, r24, f11, f21, f12, f22)
        call plane_rotation(f11, f21, f12, f22, q11, q21, q12, q22)
        r_mid(e, 1, 1) = q11
        r_mid(e, 2, 1) = q21
        r_mid(e, 1, 2) = q12
        r_mid(e, 2, 2) = q22
        call plane_defgrad(nx2 - nx1, nx3 - nx1, nx4 - nx1, ny2 - ny1, ny3 - ny1, ny4 - ny1, &
-            bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
-            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
+            r12, r13, r14, r22, r23, r24, f11, f21, f12, f22)
        f_new(e, 1, 1) = f11
        f_new(e, 2, 1) = f21
        f_new(e, 1, 2) = f12
