@@ -37,7 +37,7 @@ module mpm_run
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_keep, block_grow
   use mpm_shape, only: stencil_nodes_per_direction, block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, gather_gradient
-  use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance, &
+  use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance, wall_rows_behind, &
        wall_slide_velocity
   use mpm_mirror, only: mirror_plane_t, mirror_plane_setup, mirror_fold, mirror_fold_momentum
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
@@ -598,24 +598,44 @@ contains
   subroutine stable_increment(m, st)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    real(dp) :: speed, vmax, rho, detf, v1(1)
-    integer :: ib, p
+    real(dp) :: vmax, v1(1)
+    integer :: ib
 
     vmax = 0
     do ib = 1, st%nblocks
        associate (b => st%blocks(ib))
-         do p = 1, b%count
-            detf = det_f(b, p, st%nd)
-            rho = b%mass(p) / (b%vol0(p) * detf)
-            speed = sqrt(st%modulus(b%material) / rho) + norm2(b%v(p, :))
-            vmax = max(vmax, speed)
-         end do
+         call block_max_speed(b%count, st%nd, st%modulus(b%material), b%mass, b%vol0, b%f, b%v, vmax)
        end associate
     end do
     v1(1) = vmax
     call max_real(st, v1)
     st%dt_stable = m%mpm%steps(st%step)%cfl * m%mpm%cell / max(v1(1), tiny(1.0_dp))
   end subroutine stable_increment
+
+  !> vmax ← max(vmax, c_p + |v_p|) over the particles of a block, in order; c_p from the current
+  !> density m/(V0 det F). Explicit-shape dummies, as the other per-block loops (on the block's
+  !> allocatable components every access goes through the descriptor); the same expressions
+  !> in the same order as the loop it replaces.
+  pure subroutine block_max_speed(nb, nd, modulus, mass, vol0, f, v, vmax)
+    integer, intent(in) :: nb, nd
+    real(dp), intent(in) :: modulus, mass(nb), vol0(nb), f(nb, nd, nd), v(nb, nd)
+    real(dp), intent(inout) :: vmax
+    real(dp) :: speed, rho, detf
+    integer :: p
+
+    do p = 1, nb
+       if (nd == 2) then
+          detf = f(p, 1, 1) * f(p, 2, 2) - f(p, 1, 2) * f(p, 2, 1)
+       else
+          detf = f(p, 1, 1) * (f(p, 2, 2) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 2)) &
+               - f(p, 1, 2) * (f(p, 2, 1) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 1)) &
+               + f(p, 1, 3) * (f(p, 2, 1) * f(p, 3, 2) - f(p, 2, 2) * f(p, 3, 1))
+       end if
+       rho = mass(p) / (vol0(p) * detf)
+       speed = sqrt(modulus / rho) + norm2(v(p, :))
+       vmax = max(vmax, speed)
+    end do
+  end subroutine block_max_speed
 
   !> The nodes the active walls constrain: local damping leaves them alone, so that it does not
   !> change the reactions (the wall forces) of a body at rest.
@@ -709,8 +729,7 @@ contains
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
     end do
-    ! zero on inactive nodes (cleared at once, see grid_update)
-    call grid_clear(st%nd * st%g%nn, st%g%v_new)
+    ! Inactive nodes: v_new is still grid_update's zero (the walls project active nodes only).
     do i = 1, st%g%nn
        if (st%g%active(i)) st%g%v_new(:, i) = st%g%mom(:, i) / st%g%mass(i)
     end do
@@ -1006,8 +1025,8 @@ contains
   subroutine guard_particles(m, st)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    integer :: k, ib, p, nd
-    real(dp) :: x(3), d, n(3)
+    integer :: k, ib, p, nd, j, nrows, rows(particle_block_size)
+    real(dp) :: x(3), d, n(3), dist(particle_block_size)
 
     nd = st%nd
     do k = 1, size(m%mpm%walls)
@@ -1016,11 +1035,13 @@ contains
          n = w%normal
          do ib = 1, st%nblocks
             associate (b => st%blocks(ib))
-              do p = 1, b%count
+              ! the few particles behind the wall first, then each of them as before
+              call wall_rows_behind(w, b%count, nd, b%x, dist, nrows, rows)
+              do j = 1, nrows
+                 p = rows(j)
                  x = 0
                  x(1:nd) = b%x(p, :)
                  d = wall_distance(w, x)
-                 if (d >= 0) cycle
                  if (.not. wall_contains(w, nd, x, 0.0_dp)) cycle
                  b%x(p, :) = b%x(p, :) - d * n(1:nd)
                  ! The velocity into the wall goes, with the wall's own Coulomb law on what is
