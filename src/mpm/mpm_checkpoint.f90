@@ -147,13 +147,14 @@ contains
   ! ------------------------------------------------------------------------------ reading
 
   !> Read this rank's checkpoint into `blocks` (replacing what the set-up generated) and `sv`.
-  !> The grid, walls and materials must be set up already (nd, nc, ns: dimensions, stress
-  !> components, stencil nodes). Collective; on a problem `err` is raised on every rank.
-  subroutine mpm_checkpoint_load(base, comm, m, nd, nc, ns, blocks, nblocks, sv, err)
+  !> The grid, walls and materials must be set up already (nd, nc, nsup: dimensions, stress
+  !> components, stencil nodes per direction). Collective; on a problem `err` is raised on every
+  !> rank.
+  subroutine mpm_checkpoint_load(base, comm, m, nd, nc, nsup, blocks, nblocks, sv, err)
     character(len=*), intent(in) :: base
     type(MPI_Comm), intent(in) :: comm
     type(model_t), intent(in) :: m
-    integer, intent(in) :: nd, nc, ns
+    integer, intent(in) :: nd, nc, nsup
     type(particle_block_t), allocatable, intent(inout) :: blocks(:)
     integer, intent(out) :: nblocks
     type(mpm_saved_t), intent(out) :: sv
@@ -262,7 +263,7 @@ contains
     ! room to grow: inflow appends blocks (mpm_run doubles the list when it is full)
     allocate (blocks(max(16, 2 * nblocks)))
     do ib = 1, nblocks
-       call block_allocate(blocks(ib), info(1, ib), nd, nc, info(3, ib), info(4, ib), ns)
+       call block_allocate(blocks(ib), info(1, ib), nd, nc, info(3, ib), info(4, ib), nsup)
        blocks(ib)%material = info(2, ib)
        blocks(ib)%half = half(ib)
     end do

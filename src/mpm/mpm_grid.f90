@@ -23,7 +23,7 @@ module mpm_grid
      procedure :: position => grid_position
   end type grid_t
 
-  public :: grid_init, grid_reset, grid_reset_sums, grid_node_index
+  public :: grid_init, grid_reset, grid_reset_sums, grid_node_index, grid_clear
 
 contains
 
@@ -61,10 +61,19 @@ contains
   !> zero velocities on inactive nodes), so zeroing them as well was wasted stores.
   subroutine grid_reset_sums(g)
     type(grid_t), intent(inout) :: g
-    g%mass = 0
-    g%mom = 0
-    g%force = 0
+    call grid_clear(g%nn, g%mass)
+    call grid_clear(g%ndim * g%nn, g%mom)
+    call grid_clear(g%ndim * g%nn, g%force)
   end subroutine grid_reset_sums
+
+  !> a(1:n) = 0 for a whole contiguous grid array. Why not `g%mom = 0`: gfortran scalarised the
+  !> (ndim, nn) assignment column by column and called memset for every node (two calls a node
+  !> per increment in grid_reset_sums alone); one explicit-shape loop is one memset.
+  pure subroutine grid_clear(n, a)
+    integer, intent(in) :: n
+    real(dp), intent(out) :: a(n)
+    a = 0
+  end subroutine grid_clear
 
   !> Position of node `node` (1-based index).
   pure function grid_position(g, node) result(x)

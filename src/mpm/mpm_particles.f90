@@ -27,26 +27,28 @@ module mpm_particles
      real(dp), allocatable :: state(:, :), field(:, :)
      real(dp), allocatable :: e_int(:), e_inel(:) !< specific energies
      real(dp), allocatable :: log_strain(:, :)    !< accumulated corotational strain (LE)
-     ! Stencil of the current increment (mpm_shape layout).
-     integer, allocatable :: node(:, :)
-     real(dp), allocatable :: w(:, :), dw(:, :)
+     ! Stencil of the current increment (mpm_shape layout): first node, 1D weights and
+     ! derivatives (count, nsup, ndim).
+     integer, allocatable :: corner(:)
+     real(dp), allocatable :: w1(:, :, :), dw1(:, :, :)
   end type particle_block_t
 
   public :: block_allocate, block_keep, block_grow
 
 contains
 
-  !> A block of n particles (zeros, F = R = I); whatever b held before is released.
-  subroutine block_allocate(b, n, ndim, ncomp, nstatev, nfieldv, ns)
+  !> A block of n particles (zeros, F = R = I); whatever b held before is released. nsup:
+  !> stencil nodes per direction.
+  subroutine block_allocate(b, n, ndim, ncomp, nstatev, nfieldv, nsup)
     type(particle_block_t), intent(out) :: b
-    integer, intent(in) :: n, ndim, ncomp, nstatev, nfieldv, ns
+    integer, intent(in) :: n, ndim, ncomp, nstatev, nfieldv, nsup
     integer :: k
 
     b%count = n
     allocate (b%number(n), b%x(n, ndim), b%v(n, ndim), b%mass(n), b%vol0(n), b%f(n, ndim, ndim), &
          b%rot(n, ndim, ndim), b%stress(n, ncomp), b%stress_global(n, ncomp), b%state(n, nstatev), &
-         b%field(n, nfieldv), b%e_int(n), b%e_inel(n), b%log_strain(n, ncomp), b%node(n, ns), b%w(n, ns), &
-         b%dw(n, ns * ndim))
+         b%field(n, nfieldv), b%e_int(n), b%e_inel(n), b%log_strain(n, ncomp), b%corner(n), &
+         b%w1(n, nsup, ndim), b%dw1(n, nsup, ndim))
     b%number = 0
     b%x = 0
     b%v = 0
@@ -65,9 +67,9 @@ contains
     b%e_int = 0
     b%e_inel = 0
     b%log_strain = 0
-    b%node = 1
-    b%w = 0
-    b%dw = 0
+    b%corner = 1
+    b%w1 = 0
+    b%dw1 = 0
   end subroutine block_allocate
 
   !> Keep the particles keep(1:nk) (ascending row numbers), drop the others.
@@ -90,9 +92,9 @@ contains
     call keep_r1(b%e_int, keep)
     call keep_r1(b%e_inel, keep)
     call keep_r2(b%log_strain, keep)
-    call keep_i2(b%node, keep)
-    call keep_r2(b%w, keep)
-    call keep_r2(b%dw, keep)
+    call keep_i1(b%corner, keep)
+    call keep_r3(b%w1, keep)
+    call keep_r3(b%dw1, keep)
   end subroutine block_keep
 
   !> Grow the block to n >= count particles; the new rows start as block_allocate leaves them.
@@ -103,7 +105,7 @@ contains
     integer :: m
 
     m = b%count
-    call block_allocate(g, n, ndim, size(b%stress, 2), size(b%state, 2), size(b%field, 2), size(b%w, 2))
+    call block_allocate(g, n, ndim, size(b%stress, 2), size(b%state, 2), size(b%field, 2), size(b%w1, 2))
     g%material = b%material
     g%half = b%half
     g%number(1:m) = b%number
@@ -158,13 +160,4 @@ contains
     t = a(keep)
     call move_alloc(t, a)
   end subroutine keep_i1
-
-  subroutine keep_i2(a, keep)
-    integer, allocatable, intent(inout) :: a(:, :)
-    integer, intent(in) :: keep(:)
-    integer, allocatable :: t(:, :)
-    allocate (t(size(keep), size(a, 2)))
-    t = a(keep, :)
-    call move_alloc(t, a)
-  end subroutine keep_i2
 end module mpm_particles

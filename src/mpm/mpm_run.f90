@@ -33,11 +33,11 @@ module mpm_run
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
   use mpm_scene, only: mpm_scene_t, particle_region_t, mpm_inflow_t, region_box, region_polygon
-  use mpm_grid, only: grid_t, grid_init, grid_reset_sums
+  use mpm_grid, only: grid_t, grid_init, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_keep, block_grow
   use mpm_shape, only: stencil_nodes_per_direction, block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, gather_gradient
-  use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance, &
+  use mpm_walls, only: wall_nodes_t, wall_find_nodes, wall_project, wall_contains, wall_distance, wall_rows_behind, &
        wall_slide_velocity
   use mpm_mirror, only: mirror_plane_t, mirror_plane_setup, mirror_fold, mirror_fold_momentum
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
@@ -71,7 +71,7 @@ module mpm_run
   type :: mpm_state_t
      type(MPI_Comm) :: comm
      integer :: rank = 0, nranks = 1
-     integer :: nd = 0, nc = 0, nshr = 0, ns = 0
+     integer :: nd = 0, nc = 0, nshr = 0, nsup = 0
      type(grid_t) :: g
      integer :: nblocks = 0
      type(particle_block_t), allocatable :: blocks(:)
@@ -81,7 +81,12 @@ module mpm_run
      logical, allocatable :: mirrored(:)
      real(dp), allocatable :: modulus(:)             !< per material: λ + 2G (packaging call)
      logical, allocatable :: needs_kinematics(:)     !< per material: user VUMAT reads F, U
-     type(vumat_work_t) :: work
+     !> VUMAT work sets: work(1) has particle_block_size rows (full blocks), work(2) the rows of
+     !> the last partial block (made again when a block of another count comes). Why: with
+     !> exactly nb rows every (1:nb, ...) section the door passes is the whole, contiguous array
+     !> (no pack/unpack copies) and the new stress and state are swapped in, not copied.
+     type(vumat_work_t) :: work(2)
+     integer :: work_statev = 1, work_fieldv = 1     !< columns of the work sets (largest of the materials)
      integer :: next_number = 0
      ! mass bookkeeping (exact: particle masses never change)
      real(dp) :: mass_initial = 0, mass_in = 0, mass_out = 0   !< mass_out: rank
@@ -397,7 +402,7 @@ contains
          st%nc = 6
          st%nshr = 3
       end if
-      st%ns = stencil_nodes_per_direction(mpm%shape)**st%nd
+      st%nsup = stencil_nodes_per_direction(mpm%shape)
       call grid_init(st%g, st%nd, mpm%lo, mpm%hi, mpm%cell)
       allocate (st%modulus(m%n_materials), st%needs_kinematics(m%n_materials))
       nsv = 1
@@ -410,15 +415,9 @@ contains
          nfv = max(nfv, m%materials(k)%nfieldv)
          if (m%materials(k)%user_field) any_user_field = .true.
       end do
-      call vumat_work_init(st%work, particle_block_size, st%nc, st%nshr, nsv, nfv)
-      do k = 1, particle_block_size
-         st%work%stretch_old(k, :) = 0
-         st%work%stretch_old(k, 1:3) = 1
-         st%work%defgrad_old(k, :) = 0
-         st%work%defgrad_old(k, 1:3) = 1
-      end do
-      st%work%stretch_new = st%work%stretch_old
-      st%work%defgrad_new = st%work%defgrad_old
+      st%work_statev = nsv
+      st%work_fieldv = nfv
+      call material_work_init(st, st%work(1), particle_block_size)
       allocate (st%blocks(16))
       st%nblocks = 0
       do k = 1, size(mpm%regions)
@@ -573,7 +572,7 @@ contains
           st%nblocks = st%nblocks + 1
           ib = st%nblocks
           call block_allocate(st%blocks(ib), 0, nd, st%nc, max(1, m%materials(material)%nstatev), &
-               max(1, m%materials(material)%nfieldv), st%ns)
+               max(1, m%materials(material)%nfieldv), st%nsup)
           st%blocks(ib)%material = material
           st%blocks(ib)%half = half
        end if
@@ -599,24 +598,44 @@ contains
   subroutine stable_increment(m, st)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    real(dp) :: speed, vmax, rho, detf, v1(1)
-    integer :: ib, p
+    real(dp) :: vmax, v1(1)
+    integer :: ib
 
     vmax = 0
     do ib = 1, st%nblocks
        associate (b => st%blocks(ib))
-         do p = 1, b%count
-            detf = det_f(b, p, st%nd)
-            rho = b%mass(p) / (b%vol0(p) * detf)
-            speed = sqrt(st%modulus(b%material) / rho) + norm2(b%v(p, :))
-            vmax = max(vmax, speed)
-         end do
+         call block_max_speed(b%count, st%nd, st%modulus(b%material), b%mass, b%vol0, b%f, b%v, vmax)
        end associate
     end do
     v1(1) = vmax
     call max_real(st, v1)
     st%dt_stable = m%mpm%steps(st%step)%cfl * m%mpm%cell / max(v1(1), tiny(1.0_dp))
   end subroutine stable_increment
+
+  !> vmax ← max(vmax, c_p + |v_p|) over the particles of a block, in order; c_p from the current
+  !> density m/(V0 det F). Explicit-shape dummies, as the other per-block loops (on the block's
+  !> allocatable components every access goes through the descriptor); the same expressions
+  !> in the same order as the loop it replaces.
+  pure subroutine block_max_speed(nb, nd, modulus, mass, vol0, f, v, vmax)
+    integer, intent(in) :: nb, nd
+    real(dp), intent(in) :: modulus, mass(nb), vol0(nb), f(nb, nd, nd), v(nb, nd)
+    real(dp), intent(inout) :: vmax
+    real(dp) :: speed, rho, detf
+    integer :: p
+
+    do p = 1, nb
+       if (nd == 2) then
+          detf = f(p, 1, 1) * f(p, 2, 2) - f(p, 1, 2) * f(p, 2, 1)
+       else
+          detf = f(p, 1, 1) * (f(p, 2, 2) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 2)) &
+               - f(p, 1, 2) * (f(p, 2, 1) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 1)) &
+               + f(p, 1, 3) * (f(p, 2, 1) * f(p, 3, 2) - f(p, 2, 2) * f(p, 3, 1))
+       end if
+       rho = mass(p) / (vol0(p) * detf)
+       speed = sqrt(modulus / rho) + norm2(v(p, :))
+       vmax = max(vmax, speed)
+    end do
+  end subroutine block_max_speed
 
   !> The nodes the active walls constrain: local damping leaves them alone, so that it does not
   !> change the reactions (the wall forces) of a body at rest.
@@ -702,7 +721,7 @@ contains
 
     ! G2P and the MUSL remap
     call timer_start(fx%timers, fx%id(fx_g2p))
-    st%g%mom = 0
+    call grid_clear(st%nd * st%g%nn, st%g%mom)
     do ib = 1, st%nblocks
        call g2p(m, st, st%blocks(ib))
     end do
@@ -710,12 +729,9 @@ contains
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
     end do
+    ! Inactive nodes: v_new is still grid_update's zero (the walls project active nodes only).
     do i = 1, st%g%nn
-       if (st%g%active(i)) then
-          st%g%v_new(:, i) = st%g%mom(:, i) / st%g%mass(i)
-       else
-          st%g%v_new(:, i) = 0
-       end if
+       if (st%g%active(i)) st%g%v_new(:, i) = st%g%mom(:, i) / st%g%mass(i)
     end do
     call timer_stop(fx%timers, fx%id(fx_g2p))
     if (fx%active(fx_walls)) then
@@ -781,8 +797,8 @@ contains
     integer :: outside
     character(len=160) :: text
 
-    call block_stencil(b%count, st%nd, m%mpm%shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%node, b%w, &
-         b%dw, outside)
+    call block_stencil(b%count, st%nd, st%nsup, m%mpm%shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%corner, &
+         b%w1, b%dw1, outside)
     if (outside /= 0) then
        write (text, '(a,i0,a,3es12.4,a,es12.5)') 'particle ', b%number(outside), ' at ', b%x(outside, :), &
             ' left the background grid at t = ', st%total_time
@@ -797,12 +813,11 @@ contains
   subroutine p2g(st, b)
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(in) :: b
-    integer :: p, k, nd, ns, nb
+    integer :: p, k, nd, nb
     real(dp) :: vol(b%count)
     real(dp) :: mv(b%count, st%nd), vs(b%count, st%nc), mg(b%count, st%nd)
 
     nd = st%nd
-    ns = st%ns
     nb = b%count
     ! column by column (particle index innermost): the row-wise form was a quarter of p2g
     do p = 1, nb
@@ -815,8 +830,8 @@ contains
        mv(:, k) = b%mass * b%v(:, k)
        mg(:, k) = b%mass * st%gravity(k)
     end do
-    call scatter_p2g(nb, ns, nd, st%nc, st%g%nn, b%node, b%w, b%dw, b%mass, mv, vs, mg, st%g%mass, st%g%mom, &
-         st%g%force)
+    call scatter_p2g(nb, st%nsup, nd, st%nc, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
+         b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
   end subroutine p2g
 
   !> v_I^n = p_I/m_I; [local damping f ← f − a|f| sgn v]; v_I^{n+1} = v_I^n + Δt f_I/m_I.
@@ -828,13 +843,13 @@ contains
 
     a = m%mpm%steps(st%step)%damping
     dt = st%dt
+    ! Inactive nodes keep zero velocities: both arrays are cleared in one go first (per node,
+    ! `v(:, i) = 0` was a memset call each, two for every inactive node).
+    call grid_clear(st%nd * st%g%nn, st%g%v_old)
+    call grid_clear(st%nd * st%g%nn, st%g%v_new)
     do i = 1, st%g%nn
        st%g%active(i) = st%g%mass(i) > st%mass_cutoff
-       if (.not. st%g%active(i)) then
-          st%g%v_old(:, i) = 0
-          st%g%v_new(:, i) = 0
-          cycle
-       end if
+       if (.not. st%g%active(i)) cycle
        do k = 1, st%nd
           st%g%v_old(k, i) = st%g%mom(k, i) / st%g%mass(i)
           f = st%g%force(k, i)
@@ -864,7 +879,8 @@ contains
     nb = b%count
     alpha = m%mpm%steps(st%step)%flip
     dt = st%dt
-    call gather_velocity(nb, st%ns, nd, st%g%nn, b%node, b%w, st%g%v_new, st%g%v_old, vpic, dv)
+    call gather_velocity(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, st%g%v_new, &
+         st%g%v_old, vpic, dv)
     wk = 0
     do k = 1, nd
        do p = 1, nb
@@ -876,7 +892,7 @@ contains
        end do
     end do
     st%w_external = st%w_external + wk
-    call scatter_momentum(nb, st%ns, nd, st%g%nn, b%node, b%w, dv, st%g%mom)
+    call scatter_momentum(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, dv, st%g%mom)
   end subroutine g2p
 
   !> Velocity gradient from the remapped grid velocities, F, the corotational increments, and
@@ -886,7 +902,7 @@ contains
     type(mpm_state_t), intent(inout) :: st
     type(mpm_effects_t), intent(inout) :: fx
     type(particle_block_t), intent(inout) :: b
-    integer :: nb, nd, p, a, c, k
+    integer :: nb, nd, p, a, c, k, iw
     real(dp) :: dt
     real(dp) :: l(b%count, st%nd, st%nd), f_mid(b%count, st%nd, st%nd), f_new(b%count, st%nd, st%nd)
     real(dp) :: r_mid(b%count, st%nd, st%nd), r_new(b%count, st%nd, st%nd)
@@ -897,7 +913,8 @@ contains
     nb = b%count
     nd = st%nd
     dt = st%dt
-    call gather_gradient(nb, st%ns, nd, st%g%nn, b%node, b%dw, st%g%v_new, l)
+    call gather_gradient(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
+         st%g%v_new, l)
     ! F_{n+1} = (I + L Δt) F_n, F_{n+½} = (I + ½ L Δt) F_n
     f_new = b%f
     f_mid = b%f
@@ -928,11 +945,21 @@ contains
     call polar_rotation(nb, nd, f_new, r_new)
     call to_corotational(nb, nd, st%nc, r_mid, strain, strain_corot)
     call relative_spin(nb, nd, spin, b%rot, r_new, r_mid, rel_spin)
+    ! the work set with exactly nb rows (material_work_init)
+    iw = 1
+    if (nb /= particle_block_size) then
+       iw = 2
+       if (.not. allocated(st%work(2)%temp)) then
+          call material_work_init(st, st%work(2), nb)
+       else if (size(st%work(2)%temp) /= nb) then
+          call material_work_init(st, st%work(2), nb)
+       end if
+    end if
     if (st%needs_kinematics(b%material)) then
-       call vumat_defgrad(nb, nd, b%f, st%work%defgrad_old(1:nb, :))
-       call vumat_defgrad(nb, nd, f_new, st%work%defgrad_new(1:nb, :))
-       call vumat_stretch(nb, nd, b%rot, b%f, st%work%stretch_old(1:nb, :))
-       call vumat_stretch(nb, nd, r_new, f_new, st%work%stretch_new(1:nb, :))
+       call vumat_defgrad(nb, nd, b%f, st%work(iw)%defgrad_old)
+       call vumat_defgrad(nb, nd, f_new, st%work(iw)%defgrad_new)
+       call vumat_stretch(nb, nd, b%rot, b%f, st%work(iw)%stretch_old)
+       call vumat_stretch(nb, nd, r_new, f_new, st%work(iw)%stretch_new)
     end if
     do p = 1, nb
        if (nd == 2) then
@@ -951,9 +978,9 @@ contains
 
     call timer_start(fx%timers, fx%id(fx_material))
     call call_material(m%materials(b%material), nb, st%nc, st%nshr, b%number, st%step_time + dt, &
-         st%total_time + dt, dt, char_length, density, strain_corot, rel_spin, st%work%stretch_old(1:nb, :), &
-         st%work%stretch_new(1:nb, :), st%work%defgrad_old(1:nb, :), st%work%defgrad_new(1:nb, :), &
-         b%log_strain, b%stress, b%state, b%field, b%e_int, b%e_inel, st%work)
+         st%total_time + dt, dt, char_length, density, strain_corot, rel_spin, st%work(iw)%stretch_old, &
+         st%work(iw)%stretch_new, st%work(iw)%defgrad_old, st%work(iw)%defgrad_new, &
+         b%log_strain, b%stress, b%state, b%field, b%e_int, b%e_inel, st%work(iw))
     call timer_stop(fx%timers, fx%id(fx_material))
 
     call timer_start(fx%timers, fx%id(fx_kinematics))
@@ -964,6 +991,22 @@ contains
     call to_global(nb, nd, st%nc, r_new, b%stress, b%stress_global)
     call timer_stop(fx%timers, fx%id(fx_kinematics))
   end subroutine stress_update
+
+  !> A VUMAT work set of `rows` rows; U = F = I, which stay for the materials that do not read
+  !> them (needs_kinematics false: stress_update does not write them).
+  subroutine material_work_init(st, w, rows)
+    type(mpm_state_t), intent(in) :: st
+    type(vumat_work_t), intent(inout) :: w
+    integer, intent(in) :: rows
+
+    call vumat_work_init(w, rows, st%nc, st%nshr, st%work_statev, st%work_fieldv)
+    w%stretch_old = 0
+    w%stretch_old(:, 1:3) = 1
+    w%defgrad_old = 0
+    w%defgrad_old(:, 1:3) = 1
+    w%stretch_new = w%stretch_old
+    w%defgrad_new = w%defgrad_old
+  end subroutine material_work_init
 
   subroutine inverted(m, st, b, p)
     type(model_t), intent(in) :: m
@@ -982,8 +1025,8 @@ contains
   subroutine guard_particles(m, st)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    integer :: k, ib, p, nd
-    real(dp) :: x(3), d, n(3)
+    integer :: k, ib, p, nd, j, nrows, rows(particle_block_size)
+    real(dp) :: x(3), d, n(3), dist(particle_block_size)
 
     nd = st%nd
     do k = 1, size(m%mpm%walls)
@@ -992,11 +1035,13 @@ contains
          n = w%normal
          do ib = 1, st%nblocks
             associate (b => st%blocks(ib))
-              do p = 1, b%count
+              ! the few particles behind the wall first, then each of them as before
+              call wall_rows_behind(w, b%count, nd, b%x, dist, nrows, rows)
+              do j = 1, nrows
+                 p = rows(j)
                  x = 0
                  x(1:nd) = b%x(p, :)
                  d = wall_distance(w, x)
-                 if (d >= 0) cycle
                  if (.not. wall_contains(w, nd, x, 0.0_dp)) cycle
                  b%x(p, :) = b%x(p, :) - d * n(1:nd)
                  ! The velocity into the wall goes, with the wall's own Coulomb law on what is
@@ -1290,7 +1335,7 @@ contains
     write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
     write (output_unit, '(a,i0,a,i0,a,i0,a,es10.3,a,a,a,i0,a)') '  mpm       ', st%nd, 'D, ', &
          st%n_initial, ' particles, ', st%g%nn, ' grid nodes, cell ', m%mpm%cell, &
-         ', shape ', trim(merge('uGIMP ', 'linear', st%ns == 3**st%nd)), ', ', st%nranks, ' rank(s)'
+         ', shape ', trim(merge('uGIMP ', 'linear', st%nsup == 3)), ', ', st%nranks, ' rank(s)'
     write (output_unit, '(a)') '  effects   ' // list
     write (output_unit, '(a)') '  output    ' // base // '.h5/.xmf (particles), ' // base // '_grid.xmf, ' // &
          base // '_history.csv'
@@ -1400,7 +1445,7 @@ contains
     type(mpm_saved_t) :: sv
     type(error_t) :: err
 
-    call mpm_checkpoint_load(base, st%comm, m, st%nd, st%nc, st%ns, st%blocks, st%nblocks, sv, err)
+    call mpm_checkpoint_load(base, st%comm, m, st%nd, st%nc, st%nsup, st%blocks, st%nblocks, sv, err)
     if (.not. err%raised) call mpm_restart_outputs(base, st%comm, st%g, st%nc, nsdv, columns, sv%frames, &
          sv%rows, wr, hist, err)
     if (err%raised) call mpm_restart_stop(st%comm, err)
