@@ -399,17 +399,9 @@ contains
           qg2 = c * q2
           energy_inc(e) = (0.0_dp + qg1 * q1) + qg2 * q2
           ! f_iI += qg_i γ_I; the trapezoidal work with the generalised forces
-          fe(e, 1, 1) = fe(e, 1, 1) + qg1 * g1
-          fe(e, 2, 1) = fe(e, 2, 1) + qg2 * g1
-          fe(e, 1, 2) = fe(e, 1, 2) + qg1 * g2
-          fe(e, 2, 2) = fe(e, 2, 2) + qg2 * g2
-          fe(e, 1, 3) = fe(e, 1, 3) + qg1 * g3
-          fe(e, 2, 3) = fe(e, 2, 3) + qg2 * g3
-          fe(e, 1, 4) = fe(e, 1, 4) + qg1 * g4
-          fe(e, 2, 4) = fe(e, 2, 4) + qg2 * g4
-          work(e) = 0.5_dp * (force_hg(e, 1, 1) + qg1) * q1 + 0.5_dp * (force_hg(e, 2, 1) + qg2) * q2
-          force_hg(e, 1, 1) = qg1
-          force_hg(e, 2, 1) = qg2
+          call add_mode_forces(g1, g2, g3, g4, q1, q2, qg1, qg2, fe(e, 1, 1), fe(e, 2, 1), fe(e, 1, 2), &
+               fe(e, 2, 2), fe(e, 1, 3), fe(e, 2, 3), fe(e, 1, 4), fe(e, 2, 4), force_hg(e, 1, 1), &
+               force_hg(e, 2, 1), work(e))
        end do
        return
     end if
@@ -444,19 +436,32 @@ contains
           qg2 = 0.0_dp
           energy_inc(e) = 0.0_dp
        end if
-       fe(e, 1, 1) = fe(e, 1, 1) + qg1 * g1
-       fe(e, 2, 1) = fe(e, 2, 1) + qg2 * g1
-       fe(e, 1, 2) = fe(e, 1, 2) + qg1 * g2
-       fe(e, 2, 2) = fe(e, 2, 2) + qg2 * g2
-       fe(e, 1, 3) = fe(e, 1, 3) + qg1 * g3
-       fe(e, 2, 3) = fe(e, 2, 3) + qg2 * g3
-       fe(e, 1, 4) = fe(e, 1, 4) + qg1 * g4
-       fe(e, 2, 4) = fe(e, 2, 4) + qg2 * g4
-       work(e) = 0.5_dp * (force_hg(e, 1, 1) + qg1) * q1 + 0.5_dp * (force_hg(e, 2, 1) + qg2) * q2
-       force_hg(e, 1, 1) = qg1
-       force_hg(e, 2, 1) = qg2
+       call add_mode_forces(g1, g2, g3, g4, q1, q2, qg1, qg2, fe(e, 1, 1), fe(e, 2, 1), fe(e, 1, 2), &
+            fe(e, 2, 2), fe(e, 1, 3), fe(e, 2, 3), fe(e, 1, 4), fe(e, 2, 4), force_hg(e, 1, 1), &
+            force_hg(e, 2, 1), work(e))
     end do
   end subroutine cpe4r_hourglass_update
+
+  !> One element's hourglass mode in both loops of cpe4r_hourglass_update: f_iI += Q_i γ_I,
+  !> work = ½ (Q_n + Q_{n+1})·q, and Q_{n+1} = Q kept (q_old in, out).
+  elemental subroutine add_mode_forces(g1, g2, g3, g4, q1, q2, qg1, qg2, f11, f21, f12, f22, f13, f23, &
+                                       f14, f24, q_old1, q_old2, work)
+    real(dp), intent(in) :: g1, g2, g3, g4, q1, q2, qg1, qg2
+    real(dp), intent(inout) :: f11, f21, f12, f22, f13, f23, f14, f24, q_old1, q_old2
+    real(dp), intent(out) :: work
+
+    f11 = f11 + qg1 * g1
+    f21 = f21 + qg2 * g1
+    f12 = f12 + qg1 * g2
+    f22 = f22 + qg2 * g2
+    f13 = f13 + qg1 * g3
+    f23 = f23 + qg2 * g3
+    f14 = f14 + qg1 * g4
+    f24 = f24 + qg2 * g4
+    work = 0.5_dp * (q_old1 + qg1) * q1 + 0.5_dp * (q_old2 + qg2) * q2
+    q_old1 = qg1
+    q_old2 = qg2
+  end subroutine add_mode_forces
   !> Area A, volume t·A and mean gradient B of one element from its node coordinates (the
   !> formulas of the module header). A degenerate element (A = 0) is caught by the inversion
   !> check; the guard only avoids 1/0 here.
