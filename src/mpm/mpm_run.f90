@@ -624,13 +624,7 @@ contains
     integer :: p
 
     do p = 1, nb
-       if (nd == 2) then
-          detf = f(p, 1, 1) * f(p, 2, 2) - f(p, 1, 2) * f(p, 2, 1)
-       else
-          detf = f(p, 1, 1) * (f(p, 2, 2) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 2)) &
-               - f(p, 1, 2) * (f(p, 2, 1) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 1)) &
-               + f(p, 1, 3) * (f(p, 2, 1) * f(p, 3, 2) - f(p, 2, 2) * f(p, 3, 1))
-       end if
+       detf = det_f(f, p, nd)
        rho = mass(p) / (vol0(p) * detf)
        speed = sqrt(modulus / rho) + norm2(v(p, :))
        vmax = max(vmax, speed)
@@ -651,15 +645,16 @@ contains
     end do
   end subroutine mark_wall_nodes
 
-  pure real(dp) function det_f(b, p, nd)
-    type(particle_block_t), intent(in) :: b
+  !> det F of particle p (p2g's volume and block_max_speed's density use the one formula).
+  pure real(dp) function det_f(f, p, nd)
+    real(dp), intent(in) :: f(:, :, :)   !< a block's F, (count, nd, nd)
     integer, intent(in) :: p, nd
     if (nd == 2) then
-       det_f = b%f(p, 1, 1) * b%f(p, 2, 2) - b%f(p, 1, 2) * b%f(p, 2, 1)
+       det_f = f(p, 1, 1) * f(p, 2, 2) - f(p, 1, 2) * f(p, 2, 1)
     else
-       det_f = b%f(p, 1, 1) * (b%f(p, 2, 2) * b%f(p, 3, 3) - b%f(p, 2, 3) * b%f(p, 3, 2)) &
-            - b%f(p, 1, 2) * (b%f(p, 2, 1) * b%f(p, 3, 3) - b%f(p, 2, 3) * b%f(p, 3, 1)) &
-            + b%f(p, 1, 3) * (b%f(p, 2, 1) * b%f(p, 3, 2) - b%f(p, 2, 2) * b%f(p, 3, 1))
+       det_f = f(p, 1, 1) * (f(p, 2, 2) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 2)) &
+            - f(p, 1, 2) * (f(p, 2, 1) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 1)) &
+            + f(p, 1, 3) * (f(p, 2, 1) * f(p, 3, 2) - f(p, 2, 2) * f(p, 3, 1))
     end if
   end function det_f
 
@@ -821,7 +816,7 @@ contains
     nb = b%count
     ! column by column (particle index innermost): the row-wise form was a quarter of p2g
     do p = 1, nb
-       vol(p) = b%vol0(p) * det_f(b, p, nd)
+       vol(p) = b%vol0(p) * det_f(b%f, p, nd)
     end do
     do k = 1, st%nc
        vs(:, k) = vol * b%stress_global(:, k)
