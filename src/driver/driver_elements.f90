@@ -16,8 +16,8 @@ module driver_elements
   use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_internal_force_bv, &
        cpe4r_hourglass_update
   use fem_c3d8r, only: c3d8r_kinematics, c3d8r_internal_force, c3d8r_hourglass
-  use fem_corotation, only: corotational_increment, deformation_gradient, to_global, vumat_defgrad, &
-       vumat_stretch
+  use fem_corotation, only: corotational_increment, deformation_gradient, to_global, rotation_matrix, &
+       vumat_defgrad, vumat_stretch
   use fem_bulk_viscosity, only: bulk_viscosity
   use driver_plastic_strain, only: add_elastic_compliance
   use parallel_partition, only: partition_t
@@ -42,6 +42,8 @@ module driver_elements
      real(dp), allocatable :: wave_speed(:), sigma_bv(:), xi(:), e_bv(:), e_hg(:), dt_el(:)
      real(dp), allocatable :: strain_inc(:, :), spin_inc(:, :), strain_corot(:, :), rel_spin(:, :)
      real(dp), allocatable :: r_mid(:, :, :), r_new(:, :, :), f_old(:, :, :), f_new(:, :, :)
+     real(dp), allocatable :: r_plane(:, :, :)        !< CPE4R: R_{n+1} in the stored plane form (nb, 2, 1)
+     real(dp), allocatable :: r_old(:, :, :)          !< CPE4R: R_n as a matrix, for vumat_stretch
      real(dp), allocatable :: rotation_swap(:, :, :)  !< unallocated: holder for the R exchange
      real(dp), allocatable :: sigma_bv_swap(:)        !< unallocated: holder for the σ_bv exchange
      real(dp), allocatable :: stretch_old(:, :), stretch_new(:, :), defgrad_old(:, :), defgrad_new(:, :)
@@ -81,7 +83,7 @@ contains
     allocate(w%strain_inc(nmax, ncomp), w%spin_inc(nmax, nshr), w%strain_corot(nmax, ncomp))
     allocate(w%rel_spin(nmax, nshr), w%stress_force(nmax, ncomp), w%stress_global(nmax, ncomp))
     allocate(w%r_mid(nmax, ndim, ndim), w%r_new(nmax, ndim, ndim), w%f_old(nmax, ndim, ndim))
-    allocate(w%f_new(nmax, ndim, ndim))
+    allocate(w%f_new(nmax, ndim, ndim), w%r_old(nmax, ndim, ndim), w%r_plane(nmax, 2, 1))
     allocate(w%stretch_old(nmax, ncomp), w%stretch_new(nmax, ncomp))
     allocate(w%defgrad_old(nmax, ncomp + nshr), w%defgrad_new(nmax, ncomp + nshr))
     ! Identity F and U for blocks whose VUMAT does not read them (they are not recomputed).
@@ -156,7 +158,8 @@ contains
        iw = work_set(ws, solver%blocks(ib)%count)
        associate (blk => solver%blocks(ib), w => ws%sets(iw))
          nb = blk%count
-         call touch_block(blk, m%mesh%element_type == element_cpe4r, ws%touch_checksum)
+         call touch_block(blk, m%mesh%element_type == element_cpe4r, &
+              m%sections(blk%section)%hourglass /= hourglass_viscous, ws%touch_checksum)
          if (nd == 2) then
             call gather_block_2d(nb, ne, solver%part%conn(:, blk%first:blk%first + nb - 1), solver%x0, &
                  solver%u, dt, solver%v, w%xe_ref, w%xe_old, w%du)
@@ -191,10 +194,11 @@ contains
   !> any arithmetic, so the misses overlap and the lines arrive at the memory's bandwidth.
   !> 15 % off the CPE4R Mohr-Coulomb loop of the benchmark hopper (median of 5 alternated runs);
   !> results unchanged (nothing is written). `plane`: CPE4R forms B0 and V0 again from the
-  !> reference coordinates, so volume_ref and bmat_ref are not read.
-  subroutine touch_block(blk, plane, checksum)
+  !> reference coordinates, so volume_ref and bmat_ref are not read; `hourglass_state`: the
+  !> stiffness form reads its hourglass state (the viscous form has none).
+  subroutine touch_block(blk, plane, hourglass_state, checksum)
     type(element_block_t), intent(in) :: blk
-    logical, intent(in) :: plane
+    logical, intent(in) :: plane, hourglass_state
     integer(int64), intent(inout) :: checksum
 
     call touch_lines(size(blk%mass), blk%mass, checksum)
@@ -204,7 +208,7 @@ contains
     call touch_lines(size(blk%e_int), blk%e_int, checksum)
     call touch_lines(size(blk%e_inel), blk%e_inel, checksum)
     call touch_lines(size(blk%sigma_bv), blk%sigma_bv, checksum)
-    call touch_lines(size(blk%hourglass), blk%hourglass, checksum)
+    if (hourglass_state) call touch_lines(size(blk%hourglass), blk%hourglass, checksum)
     call touch_lines(size(blk%force_hg), blk%force_hg, checksum)
     call touch_lines(size(blk%log_strain), blk%log_strain, checksum)
     call touch_lines(size(blk%plastic_strain), blk%plastic_strain, checksum)
@@ -313,7 +317,7 @@ contains
        call cpe4r_increment_kinematics(nb, blk%thickness, w%xe_old, w%du, w%xe_ref, &
             default_min_volume_ratio, blk%mass, blk%rotation, w%volume_mid, w%volume_abs, w%density, &
             w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, w%char_length, w%reason, &
-            w%r_mid, w%r_new, w%f_new, w%strain_corot, w%rel_spin)
+            w%r_mid, w%r_new, w%r_plane, w%f_new, w%strain_corot, w%rel_spin)
     else
        call c3d8r_kinematics(nb, w%xe_mid(1:nb, :, :), w%du(1:nb, :, :), w%xe_new(1:nb, :, :), &
             w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), &
@@ -343,7 +347,12 @@ contains
        call deformation_gradient(nb, nd, ne, blk%bmat_ref, w%xe_old(1:nb, :, :), w%f_old(1:nb, :, :))
        call vumat_defgrad(nb, nd, w%f_old(1:nb, :, :), w%defgrad_old(1:nb, :))
        call vumat_defgrad(nb, nd, w%f_new(1:nb, :, :), w%defgrad_new(1:nb, :))
-       call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
+       if (plane) then
+          call rotation_matrix(nb, nd, 1, blk%rotation, w%r_old)
+          call vumat_stretch(nb, nd, w%r_old, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
+       else
+          call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
+       end if
        call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
     end if
 
@@ -378,13 +387,24 @@ contains
        end associate
     end if
     ! R_{n+1} becomes the block's rotation by exchanging the arrays (the work set has exactly nb
-    ! rows); the old R_n is overwritten by the next corotational step.
-    call move_alloc(blk%rotation, w%rotation_swap)
-    call move_alloc(w%r_new, blk%rotation)
-    call move_alloc(w%rotation_swap, w%r_new)
+    ! rows); the old R_n is overwritten by the next corotational step. CPE4R keeps the plane
+    ! form, and the matrix R_{n+1} in w%r_new for the rest of the increment.
+    if (plane) then
+       call move_alloc(blk%rotation, w%rotation_swap)
+       call move_alloc(w%r_plane, blk%rotation)
+       call move_alloc(w%rotation_swap, w%r_plane)
+    else
+       call move_alloc(blk%rotation, w%rotation_swap)
+       call move_alloc(w%r_new, blk%rotation)
+       call move_alloc(w%rotation_swap, w%r_new)
+    end if
     ! The global stress of t_{n+1} lives in the work set only (the output forms it again from
     ! the same R and σ: the same bits); a block array of it was written to memory every increment.
-    call to_global(nb, nd, nc, blk%rotation, blk%stress, w%stress_global)
+    if (plane) then
+       call to_global(nb, nd, nc, w%r_new, blk%stress, w%stress_global)
+    else
+       call to_global(nb, nd, nc, blk%rotation, blk%stress, w%stress_global)
+    end if
 
     ! Mass scaling (driver_mass_scaling): wave speed, stable increment, bulk viscosity and
     ! hourglass see the scaled inertia; the VUMAT above got the physical density.
@@ -450,7 +470,7 @@ contains
        if (plane) then
           ! One fused kernel: forces, force change and work in one pass over the block.
           call cpe4r_hourglass_update(nb, blk%thickness, w%gamma, w%bsq, w%volume_mid, w%du, &
-               dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, blk%rotation, &
+               dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, &
                blk%hourglass, w%fe, blk%force_hg, w%e_hg_kernel, w%e_hg)
        else
           w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)

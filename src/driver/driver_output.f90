@@ -15,7 +15,7 @@ module driver_output
        field_writer_frame_count
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
   use output_timer, only: clock_text
-  use fem_corotation, only: to_global
+  use fem_corotation, only: stored_to_global
   use driver_stop_condition, only: count_stop_columns, add_stop_columns, stop_column_values
   implicit none
   private
@@ -256,8 +256,8 @@ contains
        allocate(values(n, solver%ncomp))
        do ib = 1, solver%n_blocks
           associate (b => solver%blocks(ib))
-            call to_global(b%count, solver%ndim, solver%ncomp, b%rotation, b%stress, &
-                 values(b%first:b%first + b%count - 1, :))
+            call stored_to_global(b%count, solver%ndim, size(b%rotation, 3), solver%ncomp, b%rotation, &
+                 b%stress, values(b%first:b%first + b%count - 1, :))
           end associate
        end do
        call field_writer_element_field(out%fields, 'S', solver%part%elem_global, values)
@@ -318,7 +318,8 @@ contains
 
       if (size(strain, 1) /= b%count) return
       allocate(block_values(b%count, solver%ncomp))
-      call to_global(b%count, solver%ndim, solver%ncomp, b%rotation, strain, block_values)
+      call stored_to_global(b%count, solver%ndim, size(b%rotation, 3), solver%ncomp, b%rotation, strain, &
+           block_values)
       values(b%first:b%first + b%count - 1, :) = block_values
       deallocate(block_values)
     end subroutine rotated_block_strain

@@ -12,7 +12,7 @@ module driver_setup
   use driver_vumat_call, only: packaging_modulus
   use fem_cpe4r, only: cpe4r_geometry, cpe4r_internal_force
   use fem_c3d8r, only: c3d8r_geometry, c3d8r_internal_force
-  use fem_corotation, only: identity_rotation, to_global
+  use fem_corotation, only: identity_rotation, stored_to_global
   use fem_mass, only: lumped_mass
   use material_props, only: model_from_name, model_unknown
   implicit none
@@ -137,7 +137,12 @@ contains
       blk%nstatev = max(1, mat%nstatev)
       blk%nfieldv = max(1, mat%nfieldv)
       allocate(blk%elem_number(nb), blk%thickness(nb), blk%volume_ref(nb), blk%bmat_ref(nb, nd, ne))
-      allocate(blk%mass(nb), blk%rotation(nb, nd, nd), blk%hourglass(nb, nd, solver%nmode))
+      allocate(blk%mass(nb), blk%hourglass(nb, nd, solver%nmode))
+      if (m%mesh%element_type == element_cpe4r) then
+         allocate(blk%rotation(nb, 2, 1))
+      else
+         allocate(blk%rotation(nb, nd, nd))
+      end if
       allocate(blk%stress(nb, solver%ncomp))
       allocate(blk%state(nb, blk%nstatev), blk%field(nb, blk%nfieldv), blk%e_int(nb), blk%e_inel(nb))
       ! Hourglass forces of t_n for the ALLAE work: CPE4R keeps the generalised force Q (nb, 2, 1)
@@ -182,7 +187,7 @@ contains
          call c3d8r_geometry(nb, xe, blk%volume_ref, blk%bmat_ref)
       end if
       blk%mass = mat%density * blk%volume_ref
-      call identity_rotation(nb, nd, blk%rotation)
+      call identity_rotation(nb, nd, size(blk%rotation, 3), blk%rotation)
       blk%hourglass = 0
       blk%stress = 0
       blk%state = 0
@@ -209,7 +214,8 @@ contains
        associate (blk => solver%blocks(ib))
          nb = blk%count
          allocate(fe(nb, solver%ndim, solver%nen), stress_global(nb, solver%ncomp))
-         call to_global(nb, solver%ndim, solver%ncomp, blk%rotation, blk%stress, stress_global)
+         call stored_to_global(nb, solver%ndim, size(blk%rotation, 3), solver%ncomp, blk%rotation, blk%stress, &
+              stress_global)
          if (m%mesh%element_type == element_cpe4r) then
             call cpe4r_internal_force(nb, blk%volume_ref, blk%bmat_ref, stress_global, fe)
          else

@@ -25,7 +25,10 @@ module driver_solver
      real(dp), allocatable :: volume_ref(:)
      real(dp), allocatable :: bmat_ref(:, :, :)       !< (count, ndim, nen) reference mean gradient
      real(dp), allocatable :: mass(:)                 !< element mass ρ0 V0
-     real(dp), allocatable :: rotation(:, :, :)       !< (count, ndim, ndim) R at t_n
+     !> R at t_n: C3D8R (count, 3, 3); CPE4R (count, 2, 1), the plane form (cos θ, sin θ) of
+     !> R = [c −s; s c] (fem_corotation's rotation_matrix): half the bytes read and written per
+     !> element and increment.
+     real(dp), allocatable :: rotation(:, :, :)
      real(dp), allocatable :: hourglass(:, :, :)      !< (count, ndim, nmode) stiffness-form state
      real(dp), allocatable :: stress(:, :)            !< corotational Cauchy stress at t_n
      real(dp), allocatable :: state(:, :)             !< (count, nstatev) SDVs at t_n

@@ -18,8 +18,8 @@ module fem_corotation
   implicit none
   private
 
-  public :: deformation_gradient, polar_rotation, identity_rotation
-  public :: to_corotational, to_global, relative_spin
+  public :: deformation_gradient, polar_rotation, identity_rotation, rotation_matrix
+  public :: to_corotational, to_global, stored_to_global, relative_spin
   public :: vumat_defgrad, vumat_stretch, corotational_increment
 
   !> Symmetric-tensor component k of the 3-D VUMAT order is the pair (sym_i(k), sym_j(k)).
@@ -230,17 +230,37 @@ contains
   end subroutine polar_rotation_3d_chunk
 
   !> R = I for every element (initial rotation state when the initial configuration is the
-  !> reference one).
-  pure subroutine identity_rotation(nb, ndim, r)
-    integer, intent(in) :: nb, ndim
-    real(dp), intent(out) :: r(nb, ndim, ndim)
+  !> reference one), stored as its first ncol columns: ncol = ndim the matrix, ncol = 1 in 2D
+  !> the plane form (cos θ, sin θ) = (1, 0) (rotation_matrix).
+  pure subroutine identity_rotation(nb, ndim, ncol, r)
+    integer, intent(in) :: nb, ndim, ncol
+    real(dp), intent(out) :: r(nb, ndim, ncol)
     integer :: i
 
     r = 0.0_dp
-    do i = 1, ndim
+    do i = 1, ncol
        r(:, i, i) = 1.0_dp
     end do
   end subroutine identity_rotation
+
+  !> The rotation matrices r (nb, ndim, ndim) of a block's stored rotations r_stored
+  !> (nb, ndim, ncol): the matrices themselves (ncol = ndim), or in 2D with ncol = 1 the plane
+  !> form, the first column (cos θ, sin θ) of R = [c −s; s c]. plane_rotation forms R12 as −s
+  !> to the bit (−(a/b) = (−a)/b in IEEE arithmetic), so the matrix is the one it formed.
+  pure subroutine rotation_matrix(nb, ndim, ncol, r_stored, r)
+    integer, intent(in) :: nb, ndim, ncol
+    real(dp), intent(in) :: r_stored(nb, ndim, ncol)
+    real(dp), intent(out) :: r(nb, ndim, ndim)
+
+    if (ncol == ndim) then
+       r = r_stored
+    else
+       r(:, 1, 1) = r_stored(:, 1, 1)
+       r(:, 2, 1) = r_stored(:, 2, 1)
+       r(:, 1, 2) = -r_stored(:, 2, 1)
+       r(:, 2, 2) = r_stored(:, 1, 1)
+    end if
+  end subroutine rotation_matrix
 
   !> a_c = Rᵀ a R: global → corotational components of a symmetric tensor (strain increment with
   !> R = R_{n+½}; an initial global stress with R = R_n).
@@ -262,6 +282,20 @@ contains
 
     call rotate_symmetric(nb, ndim, ncomp, r, .false., a_corot, a)
   end subroutine to_global
+
+  !> to_global with a block's stored rotations (rotation_matrix): output and set-up, off the
+  !> increment's path.
+  pure subroutine stored_to_global(nb, ndim, ncol, ncomp, r_stored, a_corot, a)
+    integer, intent(in) :: nb, ndim, ncol, ncomp
+    real(dp), intent(in) :: r_stored(nb, ndim, ncol)
+    real(dp), intent(in) :: a_corot(nb, ncomp)
+    real(dp), intent(out) :: a(nb, ncomp)
+    real(dp), allocatable :: r(:, :, :)
+
+    allocate(r(nb, ndim, ndim))
+    call rotation_matrix(nb, ndim, ncol, r_stored, r)
+    call rotate_symmetric(nb, ndim, ncomp, r, .false., a_corot, a)
+  end subroutine stored_to_global
 
   !> transposed: b = Rᵀ a R, else b = R a Rᵀ. Works on the full in-plane (2D) or 3×3 matrix;
   !> in 2D the 33 component is copied (R33 = 1).

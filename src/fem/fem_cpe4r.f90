@@ -111,7 +111,8 @@ contains
   !> xe_ref = the reference coordinates X, from which the reference mean gradient B0 and volume
   !> are formed again with cpe4r_geometry's expressions (the same bits as the set-up's): the
   !> gather reads X anyway, and 72 bytes per element and increment of stored B0 and V0 were a
-  !> fifth of what the pass read from memory. mass: element masses; r_old = R_n.
+  !> fifth of what the pass read from memory. mass: element masses; r_old = R_n in the plane
+  !> form (cos θ, sin θ) (fem_corotation's rotation_matrix); r_plane: R_{n+1} in that form.
   !> Out: volume_mid, strain_inc (global), volume_new, bmat_new, char_length,
   !> volume_abs = |volume_mid|, density = mass/|volume_mid|, reason (fem_inversion codes,
   !> check_inversion's order of tests), as corotational_increment r_mid, r_new, f_new,
@@ -120,16 +121,16 @@ contains
   !> stiffness form's scale, summed in its order).
   pure subroutine cpe4r_increment_kinematics(nb, thickness, xe_old, du, xe_ref, &
        min_volume_ratio, mass, r_old, volume_mid, volume_abs, density, gamma, bsq, &
-       strain_inc, volume_new, bmat_new, char_length, reason, r_mid, r_new, f_new, &
+       strain_inc, volume_new, bmat_new, char_length, reason, r_mid, r_new, r_plane, f_new, &
        strain_inc_corot, rel_spin)
     integer, intent(in) :: nb
     real(dp), intent(in) :: thickness(nb), xe_old(nb, 2, 4), du(nb, 2, 4), xe_ref(nb, 2, 4)
-    real(dp), intent(in) :: min_volume_ratio, mass(nb), r_old(nb, 2, 2)
+    real(dp), intent(in) :: min_volume_ratio, mass(nb), r_old(nb, 2, 1)
     real(dp), intent(out) :: volume_mid(nb), volume_abs(nb), density(nb), gamma(nb, 4), bsq(nb)
     real(dp), intent(out) :: strain_inc(nb, 4), volume_new(nb), bmat_new(nb, 2, 4)
     real(dp), intent(out) :: char_length(nb)
     integer, intent(out) :: reason(nb)
-    real(dp), intent(out) :: r_mid(nb, 2, 2), r_new(nb, 2, 2), f_new(nb, 2, 2)
+    real(dp), intent(out) :: r_mid(nb, 2, 2), r_new(nb, 2, 2), r_plane(nb, 2, 1), f_new(nb, 2, 2)
     real(dp), intent(out) :: strain_inc_corot(nb, 4), rel_spin(nb, 1)
     ! x_{n+½} (m) and x_{n+1} (n) of the four nodes
     real(dp) :: mx1, mx2, mx3, mx4, my1, my2, my3, my4, nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4
@@ -233,13 +234,15 @@ contains
        r_new(e, 2, 1) = n21
        r_new(e, 1, 2) = n12
        r_new(e, 2, 2) = n22
+       r_plane(e, 1, 1) = n11
+       r_plane(e, 2, 1) = n21
        ! strainInc = R_{n+½}ᵀ Δε R_{n+½} (q a qᵀ with q = R_{n+½}ᵀ)
        call plane_similarity(q11, q21, q12, q22, l11, l22, 0.5_dp * (l12 + l21), &
             strain_inc_corot(e, 1), strain_inc_corot(e, 2), strain_inc_corot(e, 4))
        strain_inc_corot(e, 3) = 0.0_dp
-       ! relSpinInc: ΔR = R_{n+1} R_nᵀ
+       ! relSpinInc: ΔR = R_{n+1} R_nᵀ, R_n = [c −s; s c] from its plane form
        rel_spin(e, 1) = plane_relative_spin(spin, n11, n21, n12, n22, r_old(e, 1, 1), r_old(e, 2, 1), &
-            r_old(e, 1, 2), r_old(e, 2, 2))
+            -r_old(e, 2, 1), r_old(e, 1, 1))
     end do
   end subroutine cpe4r_increment_kinematics
 
