@@ -31,6 +31,9 @@ module driver_run
   implicit none
   private
 
+  !> Nodes per chunk of finish_nodes_2d: its arrays, 1024 nodes × 10 values, stay in L2.
+  integer, parameter :: node_chunk = 1024
+
   type, public :: run_options_t
      character(len=:), allocatable :: output_base     !< path of the outputs without extension
      logical :: restart = .false.                     !< continue from the checkpoint
@@ -201,13 +204,14 @@ contains
 
       ! Velocities at mid-increment (the first increment of the run starts from v_0 with dt/2).
       dt_avg = merge(0.5_dp * dt, 0.5_dp * (solver%dt_prev + dt), solver%increment == 0)
+      call keep_constrained_velocities(solver, loads%constrained)
       if (solver%ndim == 2) then
          ! A literal component count: the compiler keeps the per-node sum in registers.
          call update_velocities(2, solver%n_nodes, solver%part%node_owned, solver%mass, dt_avg, solver%a, &
-              solver%v, solver%v_old, free_sum)
+              solver%v, free_sum)
       else
          call update_velocities(solver%ndim, solver%n_nodes, solver%part%node_owned, solver%mass, dt_avg, &
-              solver%a, solver%v, solver%v_old, free_sum)
+              solver%a, solver%v, free_sum)
       end if
 
       if (effects%active(effect_boundary)) then
@@ -310,10 +314,11 @@ contains
   !> + ¼ ΔΔt (h_n m |R/m|² + a_n·I), a_n = a − R/m (R ≠ 0 on prescribed dofs only, where a = 0).
   pure subroutine constraint_work_nodes(nd, nn, nc, constrained, mass, a, reaction, v, v_old, &
        ddt, dt_avg, work)
+    ! v_old(:, k): v_{n-1/2} of node constrained(k) (keep_constrained_velocities)
     integer, intent(in) :: nd, nn, nc
     integer, intent(in) :: constrained(nc)
     real(dp), intent(in) :: mass(nn), a(nd, nn), reaction(nd, nn), v(nd, nn)
-    real(dp), intent(in) :: v_old(nd, nn), ddt, dt_avg
+    real(dp), intent(in) :: v_old(nd, nc), ddt, dt_avg
     real(dp), intent(inout) :: work
     integer :: i, j, k
     real(dp) :: aj, rm, impulse, s_v, s_r2, s_ai, v_free
@@ -327,9 +332,9 @@ contains
        do j = 1, nd
           rm = reaction(j, i) / mass(i)
           aj = a(j, i) - rm
-          v_free = v_old(j, i) + dt_avg * a(j, i)
+          v_free = v_old(j, k) + dt_avg * a(j, i)
           impulse = mass(i) * (v(j, i) - v_free) + dt_avg * reaction(j, i)
-          s_v = s_v + impulse * (v_old(j, i) + v(j, i))
+          s_v = s_v + impulse * (v_old(j, k) + v(j, i))
           s_r2 = s_r2 + rm**2
           s_ai = s_ai + aj * impulse
        end do
@@ -337,24 +342,39 @@ contains
     end do
   end subroutine constraint_work_nodes
 
-  !> v_{n-1/2} kept, v_{n+1/2} = v_{n-1/2} + Δt_avg a_n, in one pass; free_sum = Σ m |a_n|² over
-  !> the owned nodes with mass, in node order (constraint_work).
-  pure subroutine update_velocities(nd, nn, owned, mass, dt_avg, a, v, v_old, free_sum)
+  !> v_{n-1/2} of the constrained nodes (solver%v_old, in the order of `constrained`), before the
+  !> velocity update: constraint_work needs it there only. (A copy of every node's velocity,
+  !> kept before, was a node array written to memory every increment.)
+  subroutine keep_constrained_velocities(solver, constrained)
+    type(solver_t), intent(inout) :: solver
+    integer, intent(in) :: constrained(:)
+    integer :: k
+
+    if (size(solver%v_old, 2) /= size(constrained)) then
+       deallocate(solver%v_old)
+       allocate(solver%v_old(solver%ndim, size(constrained)))
+    end if
+    do k = 1, size(constrained)
+       solver%v_old(:, k) = solver%v(:, constrained(k))
+    end do
+  end subroutine keep_constrained_velocities
+
+  !> v_{n+1/2} = v_{n-1/2} + Δt_avg a_n; free_sum = Σ m |a_n|² over the owned nodes with mass,
+  !> in node order (constraint_work).
+  pure subroutine update_velocities(nd, nn, owned, mass, dt_avg, a, v, free_sum)
     integer, intent(in) :: nd, nn
     logical, intent(in) :: owned(nn)
     real(dp), intent(in) :: mass(nn), dt_avg, a(nd, nn)
     real(dp), intent(inout) :: v(nd, nn)
-    real(dp), intent(out) :: v_old(nd, nn), free_sum
+    real(dp), intent(out) :: free_sum
     integer :: i, j
-    real(dp) :: vk, s
+    real(dp) :: s
 
     free_sum = 0
     do i = 1, nn
        s = 0
        do j = 1, nd
-          vk = v(j, i)
-          v_old(j, i) = vk
-          v(j, i) = vk + dt_avg * a(j, i)
+          v(j, i) = v(j, i) + dt_avg * a(j, i)
           s = s + a(j, i)**2
        end do
        if (owned(i) .and. mass(i) > 0) free_sum = free_sum + mass(i) * s
@@ -371,8 +391,7 @@ contains
     real(dp), intent(in) :: f_ext_old(:, :)
 
     if (solver%ndim == 2) then
-       ! A literal component count: the compiler keeps the per-node sums in registers.
-       call finish_nodes_kernel(2, solver%n_nodes, solver%part%node_owned, solver%fixed, solver%mass, &
+       call finish_nodes_2d(solver%n_nodes, solver%part%node_owned, solver%fixed, solver%mass, &
             solver%f_int, solver%f_ext, f_ext_old, solver%dt, solver%v, solver%u, solver%a, solver%reaction, &
             solver%e_external)
     else
@@ -408,6 +427,40 @@ contains
     end do
   end subroutine finish_nodes_kernel
 
+  !> finish_nodes_kernel for two components, with the same operations in the same order. The
+  !> extent 2 literal, so the arrays' stride is known and the update of u, a and the reactions
+  !> vectorises (-fno-trapping-math on this file, src/CMakeLists.txt: with nd a variable it
+  !> stayed scalar and branching). The work's ordered sum would keep that loop scalar: it has a
+  !> loop of its own, chunk by chunk, so it reads f_ext and v from the cache.
+  pure subroutine finish_nodes_2d(nn, owned, fixed, mass, f_int, f_ext, f_ext_old, dt, v, u, a, reaction, &
+       e_external)
+    integer, intent(in) :: nn
+    logical, intent(in) :: owned(nn), fixed(2, nn)
+    real(dp), intent(in) :: mass(nn), f_int(2, nn), f_ext(2, nn), f_ext_old(2, nn), dt, v(2, nn)
+    real(dp), intent(inout) :: u(2, nn), e_external
+    real(dp), intent(out) :: a(2, nn), reaction(2, nn)
+    integer :: i, j, i0, i1
+    real(dp) :: w
+
+    do i0 = 1, nn, node_chunk
+       i1 = min(nn, i0 + node_chunk - 1)
+       do i = i0, i1
+          do j = 1, 2
+             u(j, i) = u(j, i) + dt * v(j, i)
+             call dof_acceleration(fixed(j, i), mass(i), f_int(j, i), f_ext(j, i), a(j, i), reaction(j, i))
+          end do
+       end do
+       do i = i0, i1
+          if (.not. owned(i)) cycle
+          w = 0
+          do j = 1, 2
+             w = w + 0.5_dp * (f_ext_old(j, i) + f_ext(j, i)) * (dt * v(j, i))
+          end do
+          e_external = e_external + w
+       end do
+    end do
+  end subroutine finish_nodes_2d
+
   !> ½ Σ_e M_e V_e (M the P-wave modulus): the strain energy of the whole model at unit strain,
   !> equal to ½ Σ m c_d², the kinetic energy at the wave speed. Scale of "significant" energies.
   real(dp) function strain_energy_scale(solver)
@@ -435,24 +488,20 @@ contains
     end do
   end subroutine update_accelerations
 
-  !> Acceleration and reaction of one dof (update_accelerations, finish_nodes_kernel).
+  !> Acceleration and reaction of one dof (update_accelerations, finish_nodes_kernel, finish_nodes_2d).
+  !> A node no element uses (a rigid body's reference node, held by rank 0) has no mass and no
+  !> forces: it does not move unless prescribed.
   elemental subroutine dof_acceleration(fixed, mass, f_int, f_ext, a, reaction)
     logical, intent(in) :: fixed
     real(dp), intent(in) :: mass, f_int, f_ext
     real(dp), intent(out) :: a, reaction
+    real(dp) :: quotient
 
-    if (fixed) then
-       a = 0
-       reaction = f_int - f_ext
-    else if (mass <= 0) then
-       ! A node no element uses (a rigid body's reference node, held by rank 0) has no
-       ! mass and no forces: it does not move unless prescribed.
-       a = 0
-       reaction = 0
-    else
-       a = (f_ext - f_int) / mass
-       reaction = 0
-    end if
+    ! Selections, not branches, so finish_nodes_2d vectorises: the quotient is formed
+    ! everywhere, with the divisor 1 where the mass is 0 (no division by zero), and not used there.
+    quotient = (f_ext - f_int) / merge(mass, 1.0_dp, mass > 0)
+    a = merge(quotient, 0.0_dp, mass > 0 .and. .not. fixed)
+    reaction = merge(f_int - f_ext, 0.0_dp, fixed)
   end subroutine dof_acceleration
 
   !> Does a gravity load of the step have an amplitude (f_ext changes within the step)?

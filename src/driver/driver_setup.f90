@@ -39,7 +39,7 @@ contains
     allocate(solver%x0(nd, nn), solver%u(nd, nn), solver%v(nd, nn), solver%a(nd, nn))
     allocate(solver%mass(nn), solver%f_int(nd, nn), solver%f_ext(nd, nn), solver%f_contact(nd, nn))
     allocate(solver%reaction(nd, nn), solver%fixed(nd, nn))
-    allocate(solver%f_ext_old(nd, nn), solver%v_old(nd, nn))
+    allocate(solver%f_ext_old(nd, nn), solver%v_old(nd, 0))
     do i = 1, nn
        solver%x0(:, i) = m%mesh%x0(:, part%node_global(i))
     end do

@@ -70,7 +70,8 @@ module driver_solver
      real(dp), allocatable :: f_ext_old(:, :)          !< f_ext at t_n when gravity changes
      !> v_{n-1/2} of the increment: the constraint impulses (supports, walls) are m (v − v_free),
      !> v_free = v_{n-1/2} + Δt_avg a_n the unconstrained v_{n+1/2}, and their work uses both
-     !> (constraint_work forms v_free again from v_old and a: no array of its own).
+     !> (constraint_work forms v_free again from v_old and a: no array of its own). Kept for the
+     !> constrained nodes only (nd, size(loads%constrained)), in that list's order.
      real(dp), allocatable :: v_old(:, :)
      integer :: n_blocks = 0
      type(element_block_t), allocatable :: blocks(:)
