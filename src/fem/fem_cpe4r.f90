@@ -111,7 +111,8 @@ contains
   !> xe_ref = the reference coordinates X, from which the reference mean gradient B0 and volume
   !> are formed again with cpe4r_geometry's expressions (the same bits as the set-up's): the
   !> gather reads X anyway, and 72 bytes per element and increment of stored B0 and V0 were a
-  !> fifth of what the pass read from memory. mass: element masses; r_old = R_n in the plane
+  !> fifth of what the pass read from memory. The element mass is ρ0 V0 formed as the set-up
+  !> forms it (density0 × the same V0: the same bits as the block's mass); r_old = R_n in the plane
   !> form (cos θ, sin θ) (fem_corotation's rotation_matrix); r_plane: R_{n+1} in that form.
   !> Out: volume_mid, strain_inc (global), volume_new, bmat_new, char_length,
   !> volume_abs = |volume_mid|, density = mass/|volume_mid|, reason (fem_inversion codes,
@@ -120,12 +121,14 @@ contains
   !> (nb, 4), γ of x_{n+½} (cpe4r_hourglass_gamma), and bsq = Σ_iI B_iI² of B_{n+½} (the
   !> stiffness form's scale, summed in its order).
   pure subroutine cpe4r_increment_kinematics(nb, thickness, xe_old, du, xe_ref, &
-       min_volume_ratio, mass, r_old, volume_mid, volume_abs, density, gamma, bsq, &
+       min_volume_ratio, density0, r_old, volume_mid, volume_abs, density, gamma, bsq, &
        strain_inc, volume_new, bmat_new, char_length, reason, r_mid, r_new, r_plane, f_new, &
        strain_inc_corot, rel_spin)
     integer, intent(in) :: nb
-    real(dp), intent(in) :: thickness(nb), xe_old(nb, 2, 4), du(nb, 2, 4), xe_ref(nb, 2, 4)
-    real(dp), intent(in) :: min_volume_ratio, mass(nb), r_old(nb, 2, 1)
+    ! thickness, density0: the block's section thickness and material density (one section
+    ! and one material per block: two scalars, not two arrays read per element)
+    real(dp), intent(in) :: thickness, xe_old(nb, 2, 4), du(nb, 2, 4), xe_ref(nb, 2, 4)
+    real(dp), intent(in) :: min_volume_ratio, density0, r_old(nb, 2, 1)
     real(dp), intent(out) :: volume_mid(nb), volume_abs(nb), density(nb), gamma(nb, 4), bsq(nb)
     real(dp), intent(out) :: strain_inc(nb, 4), volume_new(nb), bmat_new(nb, 2, 4)
     real(dp), intent(out) :: char_length(nb)
@@ -164,19 +167,19 @@ contains
 
        ! reference B0 and V0 (cpe4r_geometry on X, as the set-up formed them)
        call quad_geometry(xe_ref(e, 1, 1), xe_ref(e, 1, 2), xe_ref(e, 1, 3), xe_ref(e, 1, 4), &
-            xe_ref(e, 2, 1), xe_ref(e, 2, 2), xe_ref(e, 2, 3), xe_ref(e, 2, 4), thickness(e), area, &
+            xe_ref(e, 2, 1), xe_ref(e, 2, 2), xe_ref(e, 2, 3), xe_ref(e, 2, 4), thickness, area, &
             vol_ref, r11, r12, r13, r14, r21, r22, r23, r24)
 
        ! x_{n+½}: volume and B (cpe4r_geometry), density, γ and Σ B² (cpe4r_hourglass_gamma,
        ! cpe4r_hourglass_update)
-       call quad_geometry(mx1, mx2, mx3, mx4, my1, my2, my3, my4, thickness(e), area, vol, &
+       call quad_geometry(mx1, mx2, mx3, mx4, my1, my2, my3, my4, thickness, area, vol, &
             b11, b12, b13, b14, b21, b22, b23, b24)
        volume_mid(e) = vol
        volume_abs(e) = abs(vol)
        ! Guarded (the max changes nothing for any valid element): the inversion check now runs
        ! in this same loop, after which the driver stops, so an inverted or collapsed element
        ! must not trap here (the debug build traps on 1/0 and 0/0).
-       density(e) = mass(e) / max(abs(vol), tiny(1.0_dp))
+       density(e) = (density0 * vol_ref) / max(abs(vol), tiny(1.0_dp))
        hx = mx1 - mx2 + mx3 - mx4
        hy = my1 - my2 + my3 - my4
        gamma(e, 1) = hg_base(1) - hx * b11 - hy * b21
@@ -196,7 +199,7 @@ contains
        spin = 0.5_dp * (l21 - l12)
 
        ! x_{n+1}: volume and B (cpe4r_geometry), L_e (cpe4r_char_length)
-       call quad_geometry(nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4, thickness(e), area, vol, &
+       call quad_geometry(nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4, thickness, area, vol, &
             bmat_new(e, 1, 1), bmat_new(e, 1, 2), bmat_new(e, 1, 3), bmat_new(e, 1, 4), &
             bmat_new(e, 2, 1), bmat_new(e, 2, 2), bmat_new(e, 2, 3), bmat_new(e, 2, 4))
        volume_new(e) = vol
@@ -318,7 +321,7 @@ contains
                                   modulus, kind, coefficient, rot_mid, rot_new, hg_state, fe, &
                                   energy_inc)
     integer, intent(in) :: nb
-    real(dp), intent(in) :: thickness(nb)
+    real(dp), intent(in) :: thickness
     real(dp), intent(in) :: xe_mid(nb, 2, 4), volume_mid(nb), bmat_mid(nb, 2, 4)
     real(dp), intent(in) :: du(nb, 2, 4), dt
     real(dp), intent(in) :: density(nb), modulus(nb)
@@ -365,7 +368,7 @@ contains
                                          modulus, kind, coefficient, rot_mid, rot_new, hg_state, &
                                          fe, force_hg, energy_inc, work)
     integer, intent(in) :: nb
-    real(dp), intent(in) :: thickness(nb)
+    real(dp), intent(in) :: thickness                !< the block's section thickness
     real(dp), intent(in) :: gamma(nb, 4), bsq(nb), volume_mid(nb)
     real(dp), intent(in) :: du(nb, 2, 4), dt
     real(dp), intent(in) :: density(nb), modulus(nb)
@@ -395,8 +398,8 @@ contains
           q1 = (((0.0_dp + g1 * du(e, 1, 1)) + g2 * du(e, 1, 2)) + g3 * du(e, 1, 3)) + g4 * du(e, 1, 4)
           q2 = (((0.0_dp + g1 * du(e, 2, 1)) + g2 * du(e, 2, 2)) + g3 * du(e, 2, 3)) + g4 * du(e, 2, 4)
           ! generalised force C q/Δt and energy C q²/Δt
-          area = abs(volume_mid(e)) / thickness(e)
-          scale = 0.25_dp * sqrt(density(e) * modulus(e)) * thickness(e) * sqrt(area)
+          area = abs(volume_mid(e)) / thickness
+          scale = 0.25_dp * sqrt(density(e) * modulus(e)) * thickness * sqrt(area)
           c = coefficient * scale / dtm
           qg1 = c * q1
           qg2 = c * q2
