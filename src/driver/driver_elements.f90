@@ -194,9 +194,9 @@ contains
   !> any arithmetic, so the misses overlap and the lines arrive at the memory's bandwidth.
   !> 15 % off the CPE4R Mohr-Coulomb loop of the benchmark hopper (median of 5 alternated runs);
   !> results unchanged (nothing is written). `plane`: CPE4R forms B0 and V0 again from the
-  !> reference coordinates (and the mass from them), so volume_ref, bmat_ref, mass and thickness
-  !> are not read; `hourglass_state`: the
-  !> stiffness form reads its hourglass state (the viscous form has none).
+  !> reference coordinates (and the mass from them), so volume_ref, bmat_ref and mass are not
+  !> read; `hourglass_state`: the stiffness form reads its hourglass state (the viscous form has
+  !> none).
   subroutine touch_block(blk, plane, hourglass_state, checksum)
     type(element_block_t), intent(in) :: blk
     logical, intent(in) :: plane, hourglass_state
@@ -313,10 +313,11 @@ contains
     plane = m%mesh%element_type == element_cpe4r
     if (plane) then
        ! Kinematics, inversion check, corotational step and density in one pass.
-       ! The section's thickness and the material's density, as the set-up formed blk%thickness
-       ! and blk%mass = ρ0 V0 from them (kinematics forms ρ0 V0 again: the same bits).
+       ! The section's thickness and the material's density, from which the set-up formed V0 and
+       ! blk%mass = ρ0 V0 (kinematics forms ρ0 V0 again: the same bits).
        call cpe4r_increment_kinematics(nb, m%sections(blk%section)%thickness, w%xe_old, w%du, w%xe_ref, &
-            default_min_volume_ratio, m%materials(blk%material)%density, blk%rotation, w%volume_mid, w%volume_abs, w%density, &
+            default_min_volume_ratio, m%materials(blk%material)%density, blk%rotation, w%volume_mid, &
+            w%volume_abs, w%density, &
             w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, w%char_length, w%reason, &
             w%r_mid, w%r_new, w%r_plane, w%f_new, w%strain_corot, w%rel_spin)
     else
@@ -470,8 +471,8 @@ contains
        ! force (cpe4r_hourglass_update).
        if (plane) then
           ! One fused kernel: forces, force change and work in one pass over the block.
-          call cpe4r_hourglass_update(nb, m%sections(blk%section)%thickness, w%gamma, w%bsq, w%volume_mid, w%du, &
-               dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, &
+          call cpe4r_hourglass_update(nb, m%sections(blk%section)%thickness, w%gamma, w%bsq, w%volume_mid, &
+               w%du, dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, &
                blk%hourglass, w%fe, blk%force_hg, w%e_hg_kernel, w%e_hg)
        else
           w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)

@@ -158,7 +158,7 @@ contains
             end do
          end do
          if (m%mesh%element_type == element_cpe4r) then
-            call cpe4r_geometry(nb, xe, blk%thickness, vol, bmat)
+            call cpe4r_geometry(nb, xe, m%sections(blk%section)%thickness, vol, bmat)
             call cpe4r_char_length(nb, xe, lc)
          else
             call c3d8r_geometry(nb, xe, vol, bmat)

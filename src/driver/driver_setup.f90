@@ -136,7 +136,7 @@ contains
     associate (mat => m%materials(blk%material))
       blk%nstatev = max(1, mat%nstatev)
       blk%nfieldv = max(1, mat%nfieldv)
-      allocate(blk%elem_number(nb), blk%thickness(nb), blk%volume_ref(nb), blk%bmat_ref(nb, nd, ne))
+      allocate(blk%elem_number(nb), blk%volume_ref(nb), blk%bmat_ref(nb, nd, ne))
       allocate(blk%mass(nb), blk%hourglass(nb, nd, solver%nmode))
       if (m%mesh%element_type == element_cpe4r) then
          allocate(blk%rotation(nb, 2, 1))
@@ -180,9 +180,8 @@ contains
             end do
          end do
       end do
-      blk%thickness = m%sections(blk%section)%thickness
       if (m%mesh%element_type == element_cpe4r) then
-         call cpe4r_geometry(nb, xe, blk%thickness, blk%volume_ref, blk%bmat_ref)
+         call cpe4r_geometry(nb, xe, m%sections(blk%section)%thickness, blk%volume_ref, blk%bmat_ref)
       else
          call c3d8r_geometry(nb, xe, blk%volume_ref, blk%bmat_ref)
       end if

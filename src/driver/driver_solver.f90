@@ -21,7 +21,6 @@ module driver_solver
      integer :: material = 0, section = 0
      integer :: nstatev = 0, nfieldv = 0              !< as the VUMAT sees them (>= 1 for storage)
      integer, allocatable :: elem_number(:)           !< user element numbers (jblock(5:))
-     real(dp), allocatable :: thickness(:)            !< plane strain thickness
      real(dp), allocatable :: volume_ref(:)
      real(dp), allocatable :: bmat_ref(:, :, :)       !< (count, ndim, nen) reference mean gradient
      real(dp), allocatable :: mass(:)                 !< element mass ρ0 V0

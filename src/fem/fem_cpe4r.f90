@@ -32,11 +32,12 @@ module fem_cpe4r
 
 contains
 
-  !> volume = t·A and the mean gradient B of a block at the configuration xe.
+  !> volume = t·A and the mean gradient B of a block at the configuration xe; t the block's
+  !> section thickness (one section per block, as every CPE4R kernel takes it).
   pure subroutine cpe4r_geometry(nb, xe, thickness, volume, bmat)
     integer, intent(in) :: nb
     real(dp), intent(in) :: xe(nb, 2, 4)
-    real(dp), intent(in) :: thickness(nb)
+    real(dp), intent(in) :: thickness
     real(dp), intent(out) :: volume(nb)
     real(dp), intent(out) :: bmat(nb, 2, 4)
     real(dp) :: area
@@ -47,7 +48,7 @@ contains
     ! per call, and five extra passes, cost more than the loop's scalar code.)
     do e = 1, nb
        call quad_geometry(xe(e, 1, 1), xe(e, 1, 2), xe(e, 1, 3), xe(e, 1, 4), xe(e, 2, 1), xe(e, 2, 2), &
-            xe(e, 2, 3), xe(e, 2, 4), thickness(e), area, volume(e), bmat(e, 1, 1), bmat(e, 1, 2), &
+            xe(e, 2, 3), xe(e, 2, 4), thickness, area, volume(e), bmat(e, 1, 1), bmat(e, 1, 2), &
             bmat(e, 1, 3), bmat(e, 1, 4), bmat(e, 2, 1), bmat(e, 2, 2), bmat(e, 2, 3), bmat(e, 2, 4))
     end do
   end subroutine cpe4r_geometry
