@@ -44,7 +44,6 @@ module driver_elements
      real(dp), allocatable :: r_mid(:, :, :), r_new(:, :, :), f_old(:, :, :), f_new(:, :, :)
      real(dp), allocatable :: r_plane(:, :, :)        !< CPE4R: R_{n+1} in the stored plane form (nb, 2, 1)
      real(dp), allocatable :: r_old(:, :, :)          !< CPE4R: R_n as a matrix, for vumat_stretch
-     real(dp), allocatable :: rotation_swap(:, :, :)  !< unallocated: holder for the R exchange
      real(dp), allocatable :: sigma_bv_swap(:)        !< unallocated: holder for the σ_bv exchange
      real(dp), allocatable :: stretch_old(:, :), stretch_new(:, :), defgrad_old(:, :), defgrad_new(:, :)
      real(dp), allocatable :: stress_force(:, :), stress_global(:, :)
@@ -388,25 +387,10 @@ contains
          call add_elastic_compliance(nb, nc, props(1), props(2), -1.0_dp, blk%stress, blk%plastic_strain)
        end associate
     end if
-    ! R_{n+1} becomes the block's rotation by exchanging the arrays (the work set has exactly nb
-    ! rows); the old R_n is overwritten by the next corotational step. CPE4R keeps the plane
-    ! form, and the matrix R_{n+1} in w%r_new for the rest of the increment.
-    if (plane) then
-       call move_alloc(blk%rotation, w%rotation_swap)
-       call move_alloc(w%r_plane, blk%rotation)
-       call move_alloc(w%rotation_swap, w%r_plane)
-    else
-       call move_alloc(blk%rotation, w%rotation_swap)
-       call move_alloc(w%r_new, blk%rotation)
-       call move_alloc(w%rotation_swap, w%r_new)
-    end if
     ! The global stress of t_{n+1} lives in the work set only (the output forms it again from
     ! the same R and σ: the same bits); a block array of it was written to memory every increment.
-    if (plane) then
-       call to_global(nb, nd, nc, w%r_new, blk%stress, w%stress_global)
-    else
-       call to_global(nb, nd, nc, blk%rotation, blk%stress, w%stress_global)
-    end if
+    ! R_{n+1} is w%r_new for the rest of the increment; the block takes it at the end.
+    call to_global(nb, nd, nc, w%r_new, blk%stress, w%stress_global)
 
     ! Mass scaling (driver_mass_scaling): wave speed, stable increment, bulk viscosity and
     ! hourglass see the scaled inertia; the VUMAT above got the physical density.
@@ -478,7 +462,7 @@ contains
           w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)
           call c3d8r_hourglass(nb, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), &
                w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), hourglass_kind, &
-               hourglass_coefficient, w%r_mid(1:nb, :, :), blk%rotation, blk%hourglass, w%fe(1:nb, :, :), &
+               hourglass_coefficient, w%r_mid(1:nb, :, :), w%r_new, blk%hourglass, w%fe(1:nb, :, :), &
                w%e_hg(1:nb))
           w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :) - w%fe_hg(1:nb, :, :)
           w%e_hg(1:nb) = 0
@@ -496,5 +480,23 @@ contains
     end if
     ! The next increment's stable time uses the current geometry and the damping just found.
     call element_stable_dt(nb, w%char_length(1:nb), w%wave_speed(1:nb), w%xi(1:nb), w%dt_el(1:nb))
+
+    ! R_{n+1} becomes the block's rotation by exchanging the arrays (the work set has exactly nb
+    ! rows); the old R_n is overwritten by the next corotational step. CPE4R keeps the plane form.
+    if (plane) then
+       call exchange_rotations(blk%rotation, w%r_plane)
+    else
+       call exchange_rotations(blk%rotation, w%r_new)
+    end if
   end subroutine block_increment
+
+  !> a ↔ b by their allocations (no copy).
+  subroutine exchange_rotations(a, b)
+    real(dp), allocatable, intent(inout) :: a(:, :, :), b(:, :, :)
+    real(dp), allocatable :: held(:, :, :)
+
+    call move_alloc(a, held)
+    call move_alloc(b, a)
+    call move_alloc(held, b)
+  end subroutine exchange_rotations
 end module driver_elements
