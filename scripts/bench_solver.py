@@ -26,7 +26,9 @@ Takes about 15 minutes on 2 cores (most of it CalculiX; the baseline build of pa
    cost per element per increment is the difference of the process wall times divided by the
    difference of element-increments, so set-up time cancels and the two codes need not take the
    same increments. Ratio = ccx cost / bulkflow cost (> 1: bulkflow faster). CalculiX's increments
-   = period / its "SELECTED time increment" (constant); bulkflow's from its own report.
+   = period / its "SELECTED time increment" (constant); bulkflow's from its own report. A missing
+   `ccx` is installed first (apt-get install calculix-ccx, as root or through sudo -n; --no-install
+   skips that, and then this part).
 3. Effects check: the Mohr-Coulomb CPE4R scene with a user field (*USER DEFINED FIELD; the ψ table
    is flat, ψ = 0 at both ends, so the mechanics are identical) and without: both timing tables,
    that 'user field' has no line when absent, peak memory (max RSS of a 1-rank run, /usr/bin/time -v)
@@ -393,6 +395,23 @@ def instruction_set(exe, build: Path, scene_dir, work, repeats, baseline_dir: Pa
               f"{med_range(rate['baseline'], 1e6)}; ratio {ratio:.2f}×; histories byte-identical: {hist[0] == hist[1]}")
 
 
+def install_ccx() -> None:
+    """Debian's CalculiX (package calculix-ccx) for part 2, when root (or sudo) and apt-get are
+    there; otherwise nothing (part 2 then says how to install it)."""
+    if not shutil.which("apt-get"):
+        return
+    prefix = [] if os.geteuid() == 0 else (["sudo", "-n"] if shutil.which("sudo") else None)
+    if prefix is None:
+        return
+    print("installing CalculiX for part 2: apt-get install -y calculix-ccx (--no-install skips this)", flush=True)
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    for cmd in (["apt-get", "update", "-qq"], ["apt-get", "install", "-y", "-qq", "calculix-ccx"]):
+        p = subprocess.run(prefix + cmd, capture_output=True, text=True, env=env)
+        if p.returncode != 0:
+            print(f"  {' '.join(cmd)} failed: {p.stderr.strip()[-300:]}")
+            return
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--build", default=str(REPO / "build"))
@@ -408,6 +427,8 @@ def main() -> int:
     ap.add_argument("--scenes", default=str(REPO / "inputs" / "bench"), help="where the scenes are written")
     ap.add_argument("--work", default=str(REPO / "out" / "bench"), help="outputs of the runs")
     ap.add_argument("--ccx", default=shutil.which("ccx") or "ccx")
+    ap.add_argument("--no-install", action="store_true",
+                    help="do not apt-get install calculix-ccx when ccx is missing (part 2 is then skipped)")
     a = ap.parse_args()
 
     exe = Path(a.build) / "bin" / "bulkflow"
@@ -433,10 +454,12 @@ def main() -> int:
     if "throughput" in only:
         throughput(exe, scene_dir, work, a.repeats, a.cases.split(","), capacity)
     if "ccx" in only:
+        if not shutil.which(a.ccx) and not a.no_install:
+            install_ccx()
         if shutil.which(a.ccx):
             ccx_comparison(exe, a.ccx, scenes, work, a.repeats, a.increments, a.ccx_increments)
         else:
-            print("\n== 2. CalculiX: ccx not found (apt-get install -y calculix-ccx); skipped")
+            print("\n== 2. CalculiX: ccx not found (apt-get install -y calculix-ccx, Debian's CalculiX); skipped")
     if "effects" in only:
         effects_check(exe, scene_dir, work, a.repeats)
     if "arch" in only:
