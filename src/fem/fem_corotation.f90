@@ -324,102 +324,64 @@ contains
     logical, intent(in) :: transposed
     real(dp), intent(in) :: a(nb, 6)
     real(dp), intent(out) :: b(nb, 6)
-    real(dp) :: q11, q12, q13, q21, q22, q23, q31, q32, q33, a1, a2, a3, a4, a5, a6
+
+    ! The branch outside the element loop (inside it would keep the loop scalar): the columns
+    ! of Rᵀ are the rows of R, so both forms are b = Q a Qᵀ on the columns named accordingly.
+    if (transposed) then
+       call rotate_symmetric_3d_columns(nb, r(:, 1, 1), r(:, 2, 1), r(:, 3, 1), r(:, 1, 2), r(:, 2, 2), &
+            r(:, 3, 2), r(:, 1, 3), r(:, 2, 3), r(:, 3, 3), a, b)
+    else
+       call rotate_symmetric_3d_columns(nb, r(:, 1, 1), r(:, 1, 2), r(:, 1, 3), r(:, 2, 1), r(:, 2, 2), &
+            r(:, 2, 3), r(:, 3, 1), r(:, 3, 2), r(:, 3, 3), a, b)
+    end if
+  end subroutine rotate_symmetric_3d
+
+  !> b = Q a Qᵀ for every element, Q given by its nine components (contiguous columns of the
+  !> block's R, so no copies).
+  pure subroutine rotate_symmetric_3d_columns(nb, q11, q12, q13, q21, q22, q23, q31, q32, q33, a, b)
+    integer, intent(in) :: nb
+    real(dp), intent(in), dimension(nb) :: q11, q12, q13, q21, q22, q23, q31, q32, q33
+    real(dp), intent(in) :: a(nb, 6)
+    real(dp), intent(out) :: b(nb, 6)
+    real(dp) :: a1, a2, a3, a4, a5, a6
     real(dp) :: t11, t12, t13, t21, t22, t23, t31, t32, t33
     real(dp) :: u11, u12, u13, u21, u22, u23, u31, u32, u33
     integer :: e
 
-    ! Two loops, the branch outside (inside it would keep the loop scalar).
-    if (transposed) then
-       !GCC$ ivdep
-       do e = 1, nb
-          ! q = Rᵀ
-          q11 = r(e, 1, 1)
-          q12 = r(e, 2, 1)
-          q13 = r(e, 3, 1)
-          q21 = r(e, 1, 2)
-          q22 = r(e, 2, 2)
-          q23 = r(e, 3, 2)
-          q31 = r(e, 1, 3)
-          q32 = r(e, 2, 3)
-          q33 = r(e, 3, 3)
-          a1 = a(e, 1)
-          a2 = a(e, 2)
-          a3 = a(e, 3)
-          a4 = a(e, 4)
-          a5 = a(e, 5)
-          a6 = a(e, 6)
-          t11 = ((0.0_dp + a1 * q11) + a4 * q12) + a6 * q13
-          t21 = ((0.0_dp + a4 * q11) + a2 * q12) + a5 * q13
-          t31 = ((0.0_dp + a6 * q11) + a5 * q12) + a3 * q13
-          t12 = ((0.0_dp + a1 * q21) + a4 * q22) + a6 * q23
-          t22 = ((0.0_dp + a4 * q21) + a2 * q22) + a5 * q23
-          t32 = ((0.0_dp + a6 * q21) + a5 * q22) + a3 * q23
-          t13 = ((0.0_dp + a1 * q31) + a4 * q32) + a6 * q33
-          t23 = ((0.0_dp + a4 * q31) + a2 * q32) + a5 * q33
-          t33 = ((0.0_dp + a6 * q31) + a5 * q32) + a3 * q33
-          u11 = ((0.0_dp + q11 * t11) + q12 * t21) + q13 * t31
-          u21 = ((0.0_dp + q21 * t11) + q22 * t21) + q23 * t31
-          u31 = ((0.0_dp + q31 * t11) + q32 * t21) + q33 * t31
-          u12 = ((0.0_dp + q11 * t12) + q12 * t22) + q13 * t32
-          u22 = ((0.0_dp + q21 * t12) + q22 * t22) + q23 * t32
-          u32 = ((0.0_dp + q31 * t12) + q32 * t22) + q33 * t32
-          u13 = ((0.0_dp + q11 * t13) + q12 * t23) + q13 * t33
-          u23 = ((0.0_dp + q21 * t13) + q22 * t23) + q23 * t33
-          u33 = ((0.0_dp + q31 * t13) + q32 * t23) + q33 * t33
-          b(e, 1) = u11
-          b(e, 2) = u22
-          b(e, 3) = u33
-          b(e, 4) = 0.5_dp * (u12 + u21)
-          b(e, 5) = 0.5_dp * (u23 + u32)
-          b(e, 6) = 0.5_dp * (u31 + u13)
-       end do
-    else
-       !GCC$ ivdep
-       do e = 1, nb
-          ! q = R
-          q11 = r(e, 1, 1)
-          q12 = r(e, 1, 2)
-          q13 = r(e, 1, 3)
-          q21 = r(e, 2, 1)
-          q22 = r(e, 2, 2)
-          q23 = r(e, 2, 3)
-          q31 = r(e, 3, 1)
-          q32 = r(e, 3, 2)
-          q33 = r(e, 3, 3)
-          a1 = a(e, 1)
-          a2 = a(e, 2)
-          a3 = a(e, 3)
-          a4 = a(e, 4)
-          a5 = a(e, 5)
-          a6 = a(e, 6)
-          t11 = ((0.0_dp + a1 * q11) + a4 * q12) + a6 * q13
-          t21 = ((0.0_dp + a4 * q11) + a2 * q12) + a5 * q13
-          t31 = ((0.0_dp + a6 * q11) + a5 * q12) + a3 * q13
-          t12 = ((0.0_dp + a1 * q21) + a4 * q22) + a6 * q23
-          t22 = ((0.0_dp + a4 * q21) + a2 * q22) + a5 * q23
-          t32 = ((0.0_dp + a6 * q21) + a5 * q22) + a3 * q23
-          t13 = ((0.0_dp + a1 * q31) + a4 * q32) + a6 * q33
-          t23 = ((0.0_dp + a4 * q31) + a2 * q32) + a5 * q33
-          t33 = ((0.0_dp + a6 * q31) + a5 * q32) + a3 * q33
-          u11 = ((0.0_dp + q11 * t11) + q12 * t21) + q13 * t31
-          u21 = ((0.0_dp + q21 * t11) + q22 * t21) + q23 * t31
-          u31 = ((0.0_dp + q31 * t11) + q32 * t21) + q33 * t31
-          u12 = ((0.0_dp + q11 * t12) + q12 * t22) + q13 * t32
-          u22 = ((0.0_dp + q21 * t12) + q22 * t22) + q23 * t32
-          u32 = ((0.0_dp + q31 * t12) + q32 * t22) + q33 * t32
-          u13 = ((0.0_dp + q11 * t13) + q12 * t23) + q13 * t33
-          u23 = ((0.0_dp + q21 * t13) + q22 * t23) + q23 * t33
-          u33 = ((0.0_dp + q31 * t13) + q32 * t23) + q33 * t33
-          b(e, 1) = u11
-          b(e, 2) = u22
-          b(e, 3) = u33
-          b(e, 4) = 0.5_dp * (u12 + u21)
-          b(e, 5) = 0.5_dp * (u23 + u32)
-          b(e, 6) = 0.5_dp * (u31 + u13)
-       end do
-    end if
-  end subroutine rotate_symmetric_3d
+    !GCC$ ivdep
+    do e = 1, nb
+       a1 = a(e, 1)
+       a2 = a(e, 2)
+       a3 = a(e, 3)
+       a4 = a(e, 4)
+       a5 = a(e, 5)
+       a6 = a(e, 6)
+       t11 = ((0.0_dp + a1 * q11(e)) + a4 * q12(e)) + a6 * q13(e)
+       t21 = ((0.0_dp + a4 * q11(e)) + a2 * q12(e)) + a5 * q13(e)
+       t31 = ((0.0_dp + a6 * q11(e)) + a5 * q12(e)) + a3 * q13(e)
+       t12 = ((0.0_dp + a1 * q21(e)) + a4 * q22(e)) + a6 * q23(e)
+       t22 = ((0.0_dp + a4 * q21(e)) + a2 * q22(e)) + a5 * q23(e)
+       t32 = ((0.0_dp + a6 * q21(e)) + a5 * q22(e)) + a3 * q23(e)
+       t13 = ((0.0_dp + a1 * q31(e)) + a4 * q32(e)) + a6 * q33(e)
+       t23 = ((0.0_dp + a4 * q31(e)) + a2 * q32(e)) + a5 * q33(e)
+       t33 = ((0.0_dp + a6 * q31(e)) + a5 * q32(e)) + a3 * q33(e)
+       u11 = ((0.0_dp + q11(e) * t11) + q12(e) * t21) + q13(e) * t31
+       u21 = ((0.0_dp + q21(e) * t11) + q22(e) * t21) + q23(e) * t31
+       u31 = ((0.0_dp + q31(e) * t11) + q32(e) * t21) + q33(e) * t31
+       u12 = ((0.0_dp + q11(e) * t12) + q12(e) * t22) + q13(e) * t32
+       u22 = ((0.0_dp + q21(e) * t12) + q22(e) * t22) + q23(e) * t32
+       u32 = ((0.0_dp + q31(e) * t12) + q32(e) * t22) + q33(e) * t32
+       u13 = ((0.0_dp + q11(e) * t13) + q12(e) * t23) + q13(e) * t33
+       u23 = ((0.0_dp + q21(e) * t13) + q22(e) * t23) + q23(e) * t33
+       u33 = ((0.0_dp + q31(e) * t13) + q32(e) * t23) + q33(e) * t33
+       b(e, 1) = u11
+       b(e, 2) = u22
+       b(e, 3) = u33
+       b(e, 4) = 0.5_dp * (u12 + u21)
+       b(e, 5) = 0.5_dp * (u23 + u32)
+       b(e, 6) = 0.5_dp * (u31 + u13)
+    end do
+  end subroutine rotate_symmetric_3d_columns
 
   !> rotate_symmetric on block temporaries, any ndim (the reference form of the 2D and 3D paths).
   pure subroutine rotate_symmetric_nd(nb, ndim, ncomp, r, transposed, a, b)
