@@ -20,7 +20,7 @@ module error_report
 
   public :: error_t
   public :: set_error, raise_error, fatal_error, report_and_stop
-  public :: format_error_location
+  public :: format_error_location, add_expectation
   public :: final_stop_i, set_final_stop, reset_final_stop
 
   !> One recorded error. `message` holds the full "file:line: text" form
@@ -86,6 +86,16 @@ contains
        call report_and_stop(file, line, message)
     end if
   end subroutine raise_error
+
+  !> Append "; expected <what>" to a raised error unless its message says what was expected
+  !> already (the rule for every message: what is wrong and what was expected).
+  subroutine add_expectation(err, what)
+    type(error_t), intent(inout) :: err
+    character(len=*), intent(in) :: what
+
+    if (.not. allocated(err%message)) err%message = 'unspecified error'
+    if (index(err%message, 'expected') == 0) err%message = err%message // '; expected ' // what
+  end subroutine add_expectation
 
   !> Print a recorded error and stop.
   subroutine fatal_error(err)

@@ -6,7 +6,7 @@ module driver_run
   use, intrinsic :: iso_fortran_env, only: output_unit
   use mpi_f08, only: MPI_Comm
   use material_kinds, only: dp
-  use error_report, only: raise_error
+  use error_report, only: error_t, raise_error
   use model, only: model_t
   use model_mesh, only: element_cpe4r
   use parallel_partition, only: partition_t, partition_model
@@ -28,6 +28,7 @@ module driver_run
   use fem_c3d8r, only: c3d8r_char_length
   use fem_stable_dt, only: element_stable_dt
   use output_timer, only: timer_report
+  use output_collective, only: stop_agreed_error
   implicit none
   private
 
@@ -70,6 +71,7 @@ contains
     real(dp) :: dt_min, energies(6)
     logical :: resumed, stop_now, condition_met
     real(dp) :: period
+    type(error_t) :: err
 
     call partition_model(m, comm, part)
     call effects%decide(m)
@@ -85,7 +87,8 @@ contains
     first_step = 1
     resumed = .false.
     if (opts%restart) then
-       call load_checkpoint(opts%output_base, solver, first_step, frames, rows)
+       call load_checkpoint(m, opts%output_base, solver, first_step, frames, rows, err)
+       if (err%raised) call stop_agreed_error(part%comm, err)
        resumed = .true.
        call open_run_output(m, solver, out, opts%output_base, frames, rows, solver%total_time)
        out%next_field = solver%restart_next_field
@@ -137,13 +140,13 @@ contains
           if (effects%active(effect_checkpoint)) then
              if (checkpoint_due(m, solver, istep) .or. solver%increment == opts%stop_after) then
                 call effects%start(effect_checkpoint)
-                call save_checkpoint(opts%output_base, solver, out)
+                call save_checkpoint(m, opts%output_base, solver, out)
                 call effects%stop(effect_checkpoint)
              end if
           else if (solver%increment == opts%stop_after) then
              ! --stop-after always leaves a checkpoint to continue from, *RESTART or not (before,
              ! a scene without *RESTART stopped, said "continue with --restart" and had none).
-             call save_checkpoint(opts%output_base, solver, out)
+             call save_checkpoint(m, opts%output_base, solver, out)
           end if
           if (solver%increment == opts%stop_after) then
              stop_now = .true.

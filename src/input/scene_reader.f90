@@ -8,6 +8,7 @@
 module scene_reader
   use error_report, only: error_t
   use keyword_reader, only: keyword_deck_t, read_keyword_file
+  use scene_digest, only: digest_deck
   use model, only: model_t
   use scene_layout, only: scene_layout_t, scan_layout
   use scene_mesh, only: mesh_sources_t, build_mesh
@@ -54,6 +55,7 @@ contains
             '*ELEMENT, *MATERIAL, *STEP, ...)'
        return
     end if
+    call digest_deck(deck, model%digest)
     call scan_layout(deck, layout, err)
     if (err%raised) return
     call read_heading(deck, model, err)

@@ -10,6 +10,7 @@ module model
   use model_amplitudes, only: amplitude_t
   use model_steps, only: step_t, interaction_t
   use mpm_scene, only: mpm_scene_t
+  use model_digest, only: scene_digest_t
   implicit none
   private
 
@@ -53,6 +54,7 @@ module model
      integer :: n_steps = 0
      type(step_t), allocatable :: steps(:)
      type(mpm_scene_t) :: mpm                 !< material-point part (active with *MPM GRID)
+     type(scene_digest_t) :: digest           !< the deck's lines, hashed (restarts check it)
   end type model_t
 
   public :: name_length

@@ -10,8 +10,8 @@
 !>     numbering, mass and particle counts in/out, energies, wall impulses and forces, the
 !>     step's output schedule, the MDR reference of the last history row, and the number of
 !>     field frames and history rows written so far;
-!>   * a fingerprint of the scene (grid, materials, regions, walls, steps, amplitudes), so that
-!>     a restart of a changed scene is refused with the item that changed.
+!>   * the scene's digest (model_digest: a hash per keyword and data line), so that a restart
+!>     of an edited scene is refused at the first line that differs (file:line).
 !> Everything else (grid, wall node lists, mirror planes, material moduli) is rebuilt by the
 !> set-up from the scene, and the grid carries no history (mpm_grid), so a restarted run
 !> repeats the uninterrupted one bit for bit.
@@ -26,16 +26,17 @@
 !> do not match) is agreed between the ranks and ends the run cleanly: rank 0 prints
 !> `bulkflow: error: file: what is wrong; expected ...`, exit status 2, no MPI_Abort.
 module mpm_checkpoint
-  use, intrinsic :: iso_fortran_env, only: error_unit, int64
-  use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Bcast, MPI_INTEGER, MPI_Finalize
+  use, intrinsic :: iso_fortran_env, only: int32
+  use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Bcast, MPI_INTEGER
   use material_kinds, only: dp
-  use error_report, only: error_t, raise_error
+  use error_report, only: error_t, raise_error, add_expectation
   use model, only: model_t
+  use model_digest, only: digest_lines, digest_words, check_scene_digest
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate
   use mpm_grid, only: grid_t
   use mpm_output, only: mpm_writer_t, mpm_writer_open
   use output_checkpoint, only: checkpoint_t, checkpoint_header_t, checkpoint_begin_write, checkpoint_put, &
-       checkpoint_end_write, checkpoint_begin_read, checkpoint_get, checkpoint_end_read, checkpoint_file_name
+       checkpoint_end_write, restart_begin_read, checkpoint_get, checkpoint_end_read, checkpoint_file_name
   use output_collective, only: agree_on_error
   use output_history, only: history_t, history_open
   use output_files, only: int_to_str
@@ -64,11 +65,9 @@ module mpm_checkpoint
   end type mpm_saved_t
 
   public :: mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
-  public :: mpm_restart_stop
 
   integer, parameter :: n_scalars = 20
   integer, parameter :: n_counters = 6
-  integer, parameter :: item_length = 96
   !> The per-particle real arrays of a block that a checkpoint holds (the stencil arrays node,
   !> w, dw are recomputed at the start of every increment).
   character(len=13), parameter :: block_fields(13) = [character(len=13) :: 'x', 'v', 'mass', 'vol0', 'f', &
@@ -108,8 +107,6 @@ contains
     type(mpm_saved_t), intent(in) :: sv
     type(checkpoint_t) :: ck
     type(checkpoint_header_t) :: header
-    real(dp), allocatable :: scene(:)
-    character(len=item_length), allocatable :: names(:)
     integer :: frames(1), ib, j, info(4, nblocks)
     real(dp), allocatable :: flat(:)
 
@@ -123,9 +120,8 @@ contains
     header%frame_count = frames(1)
     header%history_rows = sv%rows
     call checkpoint_begin_write(ck, base, comm, header)
-    call scene_fingerprint(m, scene, names)
-    call checkpoint_put(ck, 'scene_items', size(scene))
-    call checkpoint_put(ck, 'scene', scene)
+    call checkpoint_put(ck, 'scene_lines', digest_lines(m%digest))
+    call checkpoint_put(ck, 'scene_digest', digest_words(m%digest))
     call checkpoint_put(ck, 'counters', [sv%next_number, sv%n_initial, sv%n_in, sv%n_out, sv%n_guarded, nblocks])
     call checkpoint_put(ck, 'scalars', pack_scalars(sv))
     call checkpoint_put(ck, 'wall_force', sv%wall_force)
@@ -161,26 +157,18 @@ contains
     type(error_t), intent(inout) :: err
     type(checkpoint_t) :: ck
     type(checkpoint_header_t) :: header
-    real(dp), allocatable :: saved(:), scalars(:), half(:), flat(:)
+    real(dp), allocatable :: scalars(:), half(:), flat(:)
+    integer(int32), allocatable :: saved(:)
     integer, allocatable :: info(:, :), number(:)
-    integer :: n_items, counters(n_counters), ib, j, rank, nranks, nw, off
+    integer :: n_lines, counters(n_counters), ib, j, rank, nw, off
     character(len=:), allocatable :: msg, file
     logical :: any_failed
 
     call MPI_Comm_rank(comm, rank)
-    call MPI_Comm_size(comm, nranks)
     nblocks = 0
     file = checkpoint_file_name(base, rank)
-    call checkpoint_begin_read(ck, base, comm, header, err)
-    if (err%raised) then
-       if (index(err%message, 'this run has') > 0) then
-          call add_expectation(err, 'a restart on as many ranks as the run that wrote the checkpoint')
-       else
-          call add_expectation(err, 'a checkpoint ' // base // '.rst.* written by an earlier run of this scene on ' // &
-               int_to_str(nranks) // ' rank(s) with the same --output (*RESTART, WRITE or --stop-after)')
-       end if
-       return
-    end if
+    call restart_begin_read(ck, base, comm, header, err)
+    if (err%raised) return
     sv%step = header%step
     sv%increment = header%increment
     sv%step_time = header%step_time
@@ -190,18 +178,15 @@ contains
     sv%rows = header%history_rows
 
     ! The scene first: a changed scene must say so, not fail on some array's shape later.
-    n_items = 0
-    call checkpoint_get(ck, 'scene_items', n_items, err)
+    ! (Every rank holds the same scene and the same digest: all find the same difference.)
+    n_lines = 0
+    call checkpoint_get(ck, 'scene_lines', n_lines, err)
     if (err%raised) return
-    allocate (saved(max(n_items, 0)))
-    call checkpoint_get(ck, 'scene', saved, err)
+    allocate (saved(2 * max(n_lines, 0)))
+    call checkpoint_get(ck, 'scene_digest', saved, err)
     if (err%raised) return
-    call compare_scene(m, saved, msg)
-    call agree_on_error(comm, allocated(msg), msg, any_failed, file)
-    if (any_failed) then
-       call raise_error(file, 0, msg, err)
-       return
-    end if
+    call check_scene_digest(m%digest, saved, err)
+    if (err%raised) return
 
     counters = 0
     call checkpoint_get(ck, 'counters', counters, err)
@@ -315,31 +300,6 @@ contains
     call history_open(hist, base // '_history.csv', columns, comm, restart_rows=rows, err=err)
     if (err%raised) call add_expectation(err, 'the history of the run that wrote the checkpoint')
   end subroutine mpm_restart_outputs
-
-  !> End a restart that cannot continue: the error is the same on every rank (agreed), rank 0
-  !> says it once, all ranks leave MPI cleanly, exit status 2 without a backtrace.
-  subroutine mpm_restart_stop(comm, err)
-    type(MPI_Comm), intent(in) :: comm
-    type(error_t), intent(in) :: err
-    integer :: rank
-
-    call MPI_Comm_rank(comm, rank)
-    if (rank == 0) then
-       write (error_unit, '(a)') 'bulkflow: error: ' // err%message
-       flush (error_unit)
-    end if
-    call MPI_Finalize()
-    error stop 2, quiet=.true.
-  end subroutine mpm_restart_stop
-
-  !> Append "; expected <what>" unless the message says what was expected already.
-  subroutine add_expectation(err, what)
-    type(error_t), intent(inout) :: err
-    character(len=*), intent(in) :: what
-
-    if (.not. allocated(err%message)) err%message = 'restart failed'
-    if (index(err%message, 'expected') == 0) err%message = err%message // '; expected ' // what
-  end subroutine add_expectation
 
   ! ------------------------------------------------------------------------------ block fields
 
@@ -505,261 +465,4 @@ contains
     sv%last_row_out = r(20)
   end subroutine unpack_scalars
 
-  ! ------------------------------------------------------------------------------ scene
-
-  !> The scene's numbers that a restart must find unchanged, with a name for each. All counts
-  !> come first, so a structural change (another wall, step or material) is named as such and
-  !> not as some shifted value.
-  subroutine scene_fingerprint(m, values, names)
-    type(model_t), intent(in) :: m
-    real(dp), allocatable, intent(out) :: values(:)
-    character(len=item_length), allocatable, intent(out) :: names(:)
-    integer :: n, k, j, s
-    character(len=:), allocatable :: w
-
-    allocate (values(256), names(256))
-    n = 0
-    associate (mpm => m%mpm)
-      ! counts
-      call add('dimensions of *MPM GRID', real(mpm%ndim, dp))
-      call add('number of materials', real(m%n_materials, dp))
-      call add('number of *PARTICLES regions', real(size(mpm%regions), dp))
-      call add('number of *MPM WALL', real(size(mpm%walls), dp))
-      call add('number of steps', real(m%n_steps, dp))
-      call add('number of amplitudes', real(m%n_amplitudes, dp))
-      do k = 1, m%n_materials
-         call add('number of *DEPVAR of material ' // trim(m%materials(k)%name), real(m%materials(k)%nstatev, dp))
-         call add('number of constants of material ' // trim(m%materials(k)%name), &
-              real(material_constants(m, k), dp))
-      end do
-      do k = 1, size(mpm%regions)
-         call add('number of polygon vertices of *PARTICLES region ' // int_to_str(k), &
-              real(region_vertices(m, k), dp))
-      end do
-      do s = 1, m%n_steps
-         call add('number of gravity loads in step ' // int_to_str(s), real(step_gravities(m, s), dp))
-         call add('number of field outputs in step ' // int_to_str(s), real(step_field_outputs(m, s), dp))
-         call add('number of history outputs in step ' // int_to_str(s), real(step_history_outputs(m, s), dp))
-      end do
-      do k = 1, m%n_amplitudes
-         call add('number of points of amplitude ' // trim(m%amplitudes(k)%name), real(amplitude_points(m, k), dp))
-      end do
-
-      ! values
-      call add('SHAPE of *MPM GRID', real(mpm%shape, dp))
-      call add('CELL of *MPM GRID', mpm%cell)
-      do j = 1, 3
-         call add('grid lower corner ' // int_to_str(j), mpm%lo(j))
-         call add('grid upper corner ' // int_to_str(j), mpm%hi(j))
-      end do
-      call add('vertical axis', real(mpm%vertical, dp))
-      call add('*OUTFLOW', merge(1.0_dp, 0.0_dp, mpm%outflow))
-      call add('*OUTFLOW, BELOW', mpm%outflow_level)
-      do k = 1, m%n_materials
-         associate (mat => m%materials(k))
-           call add('density of material ' // trim(mat%name), mat%density)
-           call add('*USER DEFINED FIELD of material ' // trim(mat%name), real(mat%nfieldv, dp))
-           do j = 1, material_constants(m, k)
-              call add('constant ' // int_to_str(j) // ' of material ' // trim(mat%name), mat%props(j))
-           end do
-         end associate
-      end do
-      do k = 1, size(mpm%regions)
-         associate (r => mpm%regions(k))
-           w = ' of *PARTICLES region ' // int_to_str(k)
-           call add('MATERIAL' // w, real(r%material, dp))
-           call add('TYPE' // w, real(r%kind, dp))
-           call add('PPC' // w, real(r%ppc, dp))
-           do j = 1, 3
-              call add('lower corner ' // int_to_str(j) // w, r%lo(j))
-              call add('upper corner ' // int_to_str(j) // w, r%hi(j))
-              call add('velocity ' // int_to_str(j) // w, r%velocity(j))
-           end do
-           do j = 1, region_vertices(m, k)
-              call add('vertex ' // int_to_str(j) // ' x' // w, r%polygon(1, j))
-              call add('vertex ' // int_to_str(j) // ' y' // w, r%polygon(2, j))
-           end do
-         end associate
-      end do
-      do k = 1, size(mpm%walls)
-         associate (wl => mpm%walls(k))
-           w = ' of *MPM WALL ' // trim(wl%name)
-           call add('TYPE' // w, real(wl%kind, dp))
-           call add('FRICTION' // w, wl%friction)
-           call add('REACH' // w, wl%reach)
-           do j = 1, 3
-              call add('point 1, coordinate ' // int_to_str(j) // w, wl%p0(j))
-              call add('point 2, coordinate ' // int_to_str(j) // w, wl%p1(j))
-              call add('normal ' // int_to_str(j) // w, wl%normal(j))
-              call add('box lower corner ' // int_to_str(j) // w, wl%lo(j))
-              call add('box upper corner ' // int_to_str(j) // w, wl%hi(j))
-           end do
-           call add('bounds' // w, merge(1.0_dp, 0.0_dp, wl%bounded))
-           do s = 1, m%n_steps
-              call add('active in step ' // int_to_str(s) // w, merge(1.0_dp, 0.0_dp, wl%active(s)))
-           end do
-         end associate
-      end do
-      do s = 1, m%n_steps
-         associate (st => m%steps(s), ms => mpm%steps(s))
-           w = ' of step ' // int_to_str(s)
-           call add('time period' // w, st%period)
-           call add('fixed time increment' // w, st%dt_fixed)
-           call add('*MPM CONTROLS, FLIP' // w, ms%flip)
-           call add('*MPM CONTROLS, CFL' // w, ms%cfl)
-           call add('*MPM CONTROLS, DAMPING' // w, ms%damping)
-           call add('*INFLOW' // w, merge(1.0_dp, 0.0_dp, ms%inflow%on))
-           call add('*INFLOW, MATERIAL' // w, real(ms%inflow%material, dp))
-           call add('*INFLOW, PPC' // w, real(ms%inflow%ppc, dp))
-           call add('*INFLOW, LEVEL' // w, ms%inflow%level)
-           do j = 1, 3
-              call add('*INFLOW band lower end ' // int_to_str(j) // w, ms%inflow%lo(j))
-              call add('*INFLOW band upper end ' // int_to_str(j) // w, ms%inflow%hi(j))
-           end do
-           do j = 1, step_gravities(m, s)
-              associate (gl => st%gravity(j))
-                call add('gravity ' // int_to_str(j) // ' magnitude' // w, gl%magnitude)
-                call add('gravity ' // int_to_str(j) // ' direction 1' // w, gl%direction(1))
-                call add('gravity ' // int_to_str(j) // ' direction 2' // w, gl%direction(2))
-                call add('gravity ' // int_to_str(j) // ' direction 3' // w, gl%direction(3))
-                call add('gravity ' // int_to_str(j) // ' amplitude' // w, real(gl%amplitude, dp))
-              end associate
-           end do
-           ! the output schedule: the frames and rows kept by a restart must be the same
-           do j = 1, step_field_outputs(m, s)
-              call add('field output ' // int_to_str(j) // ' TIME INTERVAL' // w, st%field_outputs(j)%time_interval)
-              call add('field output ' // int_to_str(j) // ' NUMBER INTERVAL' // w, &
-                   real(st%field_outputs(j)%number_interval, dp))
-           end do
-           do j = 1, step_history_outputs(m, s)
-              call add('history output ' // int_to_str(j) // ' TIME INTERVAL' // w, &
-                   st%history_outputs(j)%time_interval)
-              call add('history output ' // int_to_str(j) // ' NUMBER INTERVAL' // w, &
-                   real(st%history_outputs(j)%number_interval, dp))
-           end do
-         end associate
-      end do
-      do k = 1, m%n_amplitudes
-         associate (a => m%amplitudes(k))
-           w = ' of amplitude ' // trim(a%name)
-           call add('DEFINITION' // w, real(a%kind, dp))
-           call add('TIME' // w, merge(1.0_dp, 0.0_dp, a%total_time))
-           do j = 1, amplitude_points(m, k)
-              call add('time of point ' // int_to_str(j) // w, a%t(j))
-              call add('value of point ' // int_to_str(j) // w, a%a(j))
-           end do
-         end associate
-      end do
-    end associate
-    values = values(1:n)
-    names = names(1:n)
-
-  contains
-
-    subroutine add(name, value)
-      character(len=*), intent(in) :: name
-      real(dp), intent(in) :: value
-      real(dp), allocatable :: grown_v(:)
-      character(len=item_length), allocatable :: grown_n(:)
-
-      if (n == size(values)) then
-         allocate (grown_v(2 * n), grown_n(2 * n))
-         grown_v(1:n) = values
-         grown_n(1:n) = names
-         call move_alloc(grown_v, values)
-         call move_alloc(grown_n, names)
-      end if
-      n = n + 1
-      values(n) = value
-      names(n) = name
-    end subroutine add
-
-  end subroutine scene_fingerprint
-
-  !> msg allocated when the saved fingerprint differs from this scene's: the first item that
-  !> differs, its value now and in the checkpoint.
-  subroutine compare_scene(m, saved, msg)
-    type(model_t), intent(in) :: m
-    real(dp), intent(in) :: saved(:)
-    character(len=:), allocatable, intent(inout) :: msg
-    real(dp), allocatable :: now(:)
-    character(len=item_length), allocatable :: names(:)
-    integer :: i
-
-    call scene_fingerprint(m, now, names)
-    do i = 1, min(size(now), size(saved))
-       ! bitwise: a restart repeats the run only with exactly the same numbers
-       if (transfer(now(i), 0_int64) == transfer(saved(i), 0_int64)) cycle
-       msg = 'the scene is not the one this checkpoint was written for: ' // trim(names(i)) // ' is ' // &
-            shortest(now(i)) // ', the checkpoint''s scene had ' // shortest(saved(i)) // '; expected the ' // &
-            'unchanged scene of the interrupted run (or a new run without --restart)'
-       return
-    end do
-    if (size(now) /= size(saved)) msg = 'the scene is not the one this checkpoint was written for (' // &
-         int_to_str(size(now)) // ' scene items, the checkpoint has ' // int_to_str(size(saved)) // &
-         '); expected the unchanged scene of the interrupted run (or a new run without --restart)'
-  end subroutine compare_scene
-
-  !> x with as few digits as read back to the same double (5.0E-02, not 0.50000000000000003E-1).
-  function shortest(x) result(text)
-    real(dp), intent(in) :: x
-    character(len=:), allocatable :: text
-    character(len=40) :: buf, fmt
-    real(dp) :: y
-    integer :: d, ios
-
-    if (abs(x - anint(x)) <= 0 .and. abs(x) < 1.0e9_dp) then
-       text = int_to_str(nint(x))
-       return
-    end if
-    do d = 1, 16
-       write (fmt, '(a,i0,a)') '(es40.', d, ')'
-       write (buf, fmt) x
-       read (buf, *, iostat=ios) y
-       if (ios == 0 .and. transfer(y, 0_int64) == transfer(x, 0_int64)) exit
-    end do
-    text = trim(adjustl(buf))
-  end function shortest
-
-  pure integer function material_constants(m, k)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: k
-    material_constants = 0
-    if (allocated(m%materials(k)%props)) material_constants = size(m%materials(k)%props)
-  end function material_constants
-
-  pure integer function region_vertices(m, k)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: k
-    region_vertices = 0
-    if (allocated(m%mpm%regions(k)%polygon)) region_vertices = size(m%mpm%regions(k)%polygon, 2)
-  end function region_vertices
-
-  pure integer function step_gravities(m, s)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: s
-    step_gravities = 0
-    if (allocated(m%steps(s)%gravity)) step_gravities = size(m%steps(s)%gravity)
-  end function step_gravities
-
-  pure integer function step_field_outputs(m, s)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: s
-    step_field_outputs = 0
-    if (allocated(m%steps(s)%field_outputs)) step_field_outputs = size(m%steps(s)%field_outputs)
-  end function step_field_outputs
-
-  pure integer function step_history_outputs(m, s)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: s
-    step_history_outputs = 0
-    if (allocated(m%steps(s)%history_outputs)) step_history_outputs = size(m%steps(s)%history_outputs)
-  end function step_history_outputs
-
-  pure integer function amplitude_points(m, k)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: k
-    amplitude_points = 0
-    if (allocated(m%amplitudes(k)%t)) amplitude_points = size(m%amplitudes(k)%t)
-  end function amplitude_points
 end module mpm_checkpoint

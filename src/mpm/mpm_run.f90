@@ -42,12 +42,13 @@ module mpm_run
   use mpm_mirror, only: mirror_plane_t, mirror_plane_setup, mirror_fold, mirror_fold_momentum
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, &
-       mpm_restart_outputs, mpm_restart_stop
+       mpm_restart_outputs
   use driver_vumat_call, only: vumat_work_t, vumat_work_init, call_material, packaging_modulus
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
   use output_timer, only: timer_set_t, timer_init, timer_register, timer_start, timer_stop, timer_report, &
        clock_text
+  use output_collective, only: stop_agreed_error
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
   implicit none
   private
@@ -1426,7 +1427,7 @@ contains
 
   !> Continue from the checkpoint of base: the set-up's particles are replaced by the
   !> checkpoint's, the outputs are reopened at it. A restart that cannot continue stops here on
-  !> every rank with the reason (mpm_restart_stop). particle_steps is not restored: the
+  !> every rank with the reason (stop_agreed_error). particle_steps is not restored: the
   !> throughput report is this run's.
   subroutine resume(m, st, base, nsdv, columns, wr, hist, next_field, next_history, last_row_time, last_row_out)
     type(model_t), intent(in) :: m
@@ -1443,7 +1444,7 @@ contains
     call mpm_checkpoint_load(base, st%comm, m, st%nd, st%nc, st%nsup, st%blocks, st%nblocks, sv, err)
     if (.not. err%raised) call mpm_restart_outputs(base, st%comm, st%g, st%nc, nsdv, columns, sv%frames, &
          sv%rows, wr, hist, err)
-    if (err%raised) call mpm_restart_stop(st%comm, err)
+    if (err%raised) call stop_agreed_error(st%comm, err)
     st%step = sv%step
     st%increment = sv%increment
     st%step_time = sv%step_time

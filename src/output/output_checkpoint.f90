@@ -25,7 +25,7 @@ module output_checkpoint
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_IN_PLACE, &
        MPI_INTEGER, MPI_MAX
   use material_kinds, only: dp
-  use error_report, only: error_t, raise_error
+  use error_report, only: error_t, raise_error, add_expectation
   use output_files, only: rename_file, delete_file, int_to_str
   use output_collective, only: agree_on_error
   implicit none
@@ -33,7 +33,7 @@ module output_checkpoint
 
   public :: checkpoint_t, checkpoint_header_t
   public :: checkpoint_begin_write, checkpoint_put, checkpoint_end_write, checkpoint_discard
-  public :: checkpoint_begin_read, checkpoint_get, checkpoint_end_read
+  public :: checkpoint_begin_read, checkpoint_get, checkpoint_end_read, restart_begin_read
   public :: checkpoint_file_name
 
   character(len=8), parameter :: magic = 'BFLOWRST'
@@ -327,6 +327,27 @@ contains
     end if
     ck%reading = .true.
   end subroutine checkpoint_begin_read
+
+  !> checkpoint_begin_read for a --restart: the error, if any, also says what a restart needs
+  !> (the same number of ranks; a checkpoint of this --output written by an earlier run).
+  subroutine restart_begin_read(ck, base, comm, header, err)
+    type(checkpoint_t), intent(out) :: ck
+    character(len=*), intent(in) :: base
+    type(MPI_Comm), intent(in) :: comm
+    type(checkpoint_header_t), intent(out) :: header
+    type(error_t), intent(inout) :: err
+    integer :: nranks
+
+    call checkpoint_begin_read(ck, base, comm, header, err)
+    if (.not. err%raised) return
+    if (index(err%message, 'this run has') > 0) then
+       call add_expectation(err, 'a restart on as many ranks as the run that wrote the checkpoint')
+    else
+       call MPI_Comm_size(comm, nranks)
+       call add_expectation(err, 'a checkpoint ' // base // '.rst.* written by an earlier run of this scene on ' // &
+            int_to_str(nranks) // ' rank(s) with the same --output (*RESTART, WRITE or --stop-after)')
+    end if
+  end subroutine restart_begin_read
 
   !> Check that everything was read (the end mark follows) and close. Collective.
   subroutine checkpoint_end_read(ck, err)

@@ -6,12 +6,14 @@
 !> any rank failed, and all receive the message of the lowest failing rank, so the caller
 !> sees the same error everywhere and can stop cleanly.
 module output_collective
+  use, intrinsic :: iso_fortran_env, only: error_unit
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Bcast, &
-       MPI_IN_PLACE, MPI_INTEGER, MPI_CHARACTER, MPI_MIN
+       MPI_IN_PLACE, MPI_INTEGER, MPI_CHARACTER, MPI_MIN, MPI_Finalize
+  use error_report, only: error_t
   implicit none
   private
 
-  public :: agree_on_error
+  public :: agree_on_error, stop_agreed_error
 
 contains
 
@@ -58,5 +60,27 @@ contains
     end subroutine broadcast_text
 
   end subroutine agree_on_error
+
+  !> End a run on an error every rank of comm knows alike (agreed, or found by all from the
+  !> same data, such as a restart that cannot continue): rank 0 says it once, all ranks leave
+  !> MPI cleanly, exit status 2 without a backtrace — where an error on one rank alone must
+  !> abort them all (error_report's final stop), with MPI's abort banner and every rank's copy.
+  subroutine stop_agreed_error(comm, err)
+    type(MPI_Comm), intent(in) :: comm
+    type(error_t), intent(in) :: err
+    integer :: rank
+
+    call MPI_Comm_rank(comm, rank)
+    if (rank == 0) then
+       if (allocated(err%message)) then
+          write (error_unit, '(a)') 'bulkflow: error: ' // err%message
+       else
+          write (error_unit, '(a)') 'bulkflow: error: unspecified error'
+       end if
+       flush (error_unit)
+    end if
+    call MPI_Finalize()
+    error stop 2, quiet=.true.
+  end subroutine stop_agreed_error
 
 end module output_collective

@@ -405,6 +405,65 @@ def cmd_restart(args, launcher: Launcher) -> None:
         bad = next((i for i, (x, y) in enumerate(zip(rows_a, rows_b)) if x != y), min(len(rows_a), len(rows_b)))
         raise CheckFailed(f'history CSV differs from row {bad}: {len(rows_a)} vs {len(rows_b)} lines')
     print('  ok   history CSV identical')
+    check_refused_restarts(args, launcher, base, n)
+
+
+def check_refused_restarts(args, launcher: Launcher, saved: Path, n: int) -> None:
+    """Restarts that cannot continue are refused cleanly — exit status 2, the reason once (rank
+    0) with what was expected, no backtrace, no MPI_Abort: no checkpoint, another rank count, an
+    edited scene (the message names the edited line). A comment added to the scene is no edit."""
+    import shutil
+    wd = args.workdir
+
+    def copy_outputs(to: Path) -> None:
+        for f in saved.parent.glob(saved.name + '.rst.*'):
+            shutil.copy(f, str(to) + f.name[len(saved.name):])
+        for suffix in ('.h5', '.xmf', '_history.csv'):
+            if Path(str(saved) + suffix).exists():
+                shutil.copy(str(saved) + suffix, str(to) + suffix)
+
+    def refused(run: Run, what: str, needles: list[str]) -> None:
+        msg = next((l for l in run.stderr.splitlines() if l.startswith('bulkflow: error:')), '')
+        text = run.stdout + run.stderr
+        print(f'  {what}: exit status {run.returncode}: {msg}')
+        problems = []
+        if run.returncode != 2:
+            problems.append(f'exit status {run.returncode}, expected 2')
+        if run.stderr.count('bulkflow: error:') != 1:
+            problems.append(f'the error is said {run.stderr.count("bulkflow: error:")} times, expected once')
+        if not all(nd in msg for nd in needles) or 'expected' not in msg:
+            problems.append(f'the message lacks {needles} or what was expected')
+        if 'Backtrace' in text or 'MPI_ABORT' in text or 'Error termination' in text:
+            problems.append('a backtrace or MPI_Abort')
+        if problems:
+            raise CheckFailed(f'{what}: ' + '; '.join(problems))
+
+    refused(launcher.run(args.scene, wd / 'none', ranks=n, extra=['--restart'], expect_success=False),
+            'no checkpoint', ['none.rst.0: cannot open the file'])
+    # (another rank count: the multi-rank tests restart on 1 rank; a 1-rank test has no mpiexec)
+    if n > 1:
+        refused(launcher.run(args.scene, saved, ranks=1, extra=['--restart'], expect_success=False),
+                f'restart on 1 rank of a {n}-rank checkpoint', [f'written by a run on {n} ranks, this run has 1'])
+
+    lines = args.scene.read_text().splitlines()
+    at = next(i for i, l in enumerate(lines) if l.upper().startswith('*DENSITY')) + 1
+    fields = lines[at].split(',')
+    fields[0] = repr(float(fields[0]) * 1.01)
+    edited = wd / f'{args.scene.stem}_edited.inp'
+    edited.write_text('\n'.join(lines[:at] + [','.join(fields)] + lines[at + 1:]) + '\n')
+    copy_outputs(wd / 'edited')
+    refused(launcher.run(edited, wd / 'edited', ranks=n, extra=['--restart'], expect_success=False),
+            f'edited scene (density on line {at + 1})',
+            [f'{edited.name}:{at + 1}: differs from the scene the checkpoint was written for'])
+
+    commented = wd / f'{args.scene.stem}_commented.inp'
+    commented.write_text('** a comment added after the checkpoint\n\n' + args.scene.read_text())
+    copy_outputs(wd / 'commented')
+    run = launcher.run(commented, wd / 'commented', ranks=n, extra=['--restart'], expect_success=False)
+    if run.returncode != 0:
+        sys.stderr.write(run.stderr)
+        raise CheckFailed(f'a comment added to the scene stopped the restart (exit status {run.returncode})')
+    print('  ok   refused restarts: clean, said once, with what was expected; a comment added is no edit')
 
 
 def cmd_inverted(args, launcher: Launcher) -> None:
