@@ -17,6 +17,7 @@ program bulkflow
   use mpm_run, only: mpm_run_scene
   use abaqus_host, only: host_set_exit_handler
   use parallel_abort, only: abort_all, abort_all_status
+  use output_collective, only: stop_agreed_error
   implicit none
   type(model_t) :: m
   type(error_t) :: err
@@ -117,11 +118,10 @@ contains
 
   !> Every rank reads the scene and finds the same problem: rank 0 says it once, all ranks
   !> leave MPI cleanly, exit status 2 (no MPI_Abort noise, no backtrace).
+  !> Every rank read the same scene and found the same error: said once, a clean exit.
   subroutine input_error_exit(err)
     type(error_t), intent(in) :: err
-    if (rank == 0) write (error_unit, '(a)') 'bulkflow: error: ' // err%message
-    call MPI_Finalize()
-    error stop 2, quiet=.true.
+    call stop_agreed_error(MPI_COMM_WORLD, err)
   end subroutine input_error_exit
 
   !> A material-point scene (particle decomposition over the ranks, src/mpm/mpm_run.f90), with
