@@ -9,11 +9,10 @@
 !> does not match) is found alike on every rank (output_checkpoint agrees its errors) and comes
 !> back in err with what was expected; the caller ends the run cleanly (stop_agreed_error).
 module driver_checkpoint
-  use, intrinsic :: iso_fortran_env, only: int32
   use material_kinds, only: dp
   use error_report, only: error_t
   use model, only: model_t
-  use model_digest, only: digest_lines, digest_words, check_scene_digest
+  use checkpoint_scene, only: put_scene_digest, check_saved_scene
   use output_checkpoint, only: checkpoint_t, checkpoint_header_t, checkpoint_begin_write, checkpoint_put, &
        checkpoint_end_write, restart_begin_read, checkpoint_get, checkpoint_end_read
   use output_hdf5, only: field_writer_frame_count
@@ -47,8 +46,7 @@ contains
     header%history_rows = history_row_count(out%history)
     call checkpoint_begin_write(ck, base, solver%part%comm, header)
     ! The scene first: a restart of another scene must say so, not fail on an array's shape.
-    call checkpoint_put(ck, 'scene_lines', digest_lines(m%digest))
-    call checkpoint_put(ck, 'scene_digest', digest_words(m%digest))
+    call put_scene_digest(ck, m%digest)
     call checkpoint_put(ck, 'u', solver%u)
     call checkpoint_put(ck, 'v', solver%v)
     call checkpoint_put(ck, 'a', solver%a)
@@ -105,8 +103,7 @@ contains
     type(checkpoint_header_t) :: header
     real(dp) :: scalars(11)
     real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
-    integer :: counters(2), ib, i, n_lines
-    integer(int32), allocatable :: saved(:)
+    integer :: counters(2), ib, i
     real(dp) :: stop_scalars(6)
     character(len=16) :: tag
 
@@ -119,14 +116,7 @@ contains
     counters = 0
     call restart_begin_read(ck, base, solver%part%comm, header, err)
     if (err%raised) return
-    n_lines = -1
-    call checkpoint_get(ck, 'scene_lines', n_lines, err)
-    if (err%raised) return
-    allocate (saved(2 * max(n_lines, 0)))
-    call checkpoint_get(ck, 'scene_digest', saved, err)
-    if (err%raised) return
-    ! Every rank holds the same scene and the same digest: all find the same difference.
-    call check_scene_digest(m%digest, saved, err)
+    call check_saved_scene(ck, m%digest, err)
     if (err%raised) return
     solver%step = header%step
     solver%increment = header%increment

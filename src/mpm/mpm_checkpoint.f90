@@ -26,12 +26,11 @@
 !> do not match) is agreed between the ranks and ends the run cleanly: rank 0 prints
 !> `bulkflow: error: file: what is wrong; expected ...`, exit status 2, no MPI_Abort.
 module mpm_checkpoint
-  use, intrinsic :: iso_fortran_env, only: int32
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Bcast, MPI_INTEGER
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error, add_expectation
   use model, only: model_t
-  use model_digest, only: digest_lines, digest_words, check_scene_digest
+  use checkpoint_scene, only: put_scene_digest, check_saved_scene
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate
   use mpm_grid, only: grid_t
   use mpm_output, only: mpm_writer_t, mpm_writer_open
@@ -120,8 +119,7 @@ contains
     header%frame_count = frames(1)
     header%history_rows = sv%rows
     call checkpoint_begin_write(ck, base, comm, header)
-    call checkpoint_put(ck, 'scene_lines', digest_lines(m%digest))
-    call checkpoint_put(ck, 'scene_digest', digest_words(m%digest))
+    call put_scene_digest(ck, m%digest)
     call checkpoint_put(ck, 'counters', [sv%next_number, sv%n_initial, sv%n_in, sv%n_out, sv%n_guarded, nblocks])
     call checkpoint_put(ck, 'scalars', pack_scalars(sv))
     call checkpoint_put(ck, 'wall_force', sv%wall_force)
@@ -158,9 +156,8 @@ contains
     type(checkpoint_t) :: ck
     type(checkpoint_header_t) :: header
     real(dp), allocatable :: scalars(:), half(:), flat(:)
-    integer(int32), allocatable :: saved(:)
     integer, allocatable :: info(:, :), number(:)
-    integer :: n_lines, counters(n_counters), ib, j, rank, nw, off
+    integer :: counters(n_counters), ib, j, rank, nw, off
     character(len=:), allocatable :: msg, file
     logical :: any_failed
 
@@ -178,14 +175,7 @@ contains
     sv%rows = header%history_rows
 
     ! The scene first: a changed scene must say so, not fail on some array's shape later.
-    ! (Every rank holds the same scene and the same digest: all find the same difference.)
-    n_lines = 0
-    call checkpoint_get(ck, 'scene_lines', n_lines, err)
-    if (err%raised) return
-    allocate (saved(2 * max(n_lines, 0)))
-    call checkpoint_get(ck, 'scene_digest', saved, err)
-    if (err%raised) return
-    call check_scene_digest(m%digest, saved, err)
+    call check_saved_scene(ck, m%digest, err)
     if (err%raised) return
 
     counters = 0
