@@ -104,7 +104,9 @@ contains
             'expected them on a *BOUNDARY inside a step', err)
        return
     end if
-    call expect_lines(blk, 1, huge(1), 'node or node set, first dof[, last dof[, value]]', err)
+    ! OP=NEW without data lines removes every boundary condition (Abaqus)
+    call expect_lines(blk, merge(0, 1, op == 'NEW'), huge(1), &
+         'node or node set, first dof[, last dof[, value]]', err)
     if (err%raised) return
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))

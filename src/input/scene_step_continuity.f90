@@ -37,6 +37,7 @@ contains
          end if
          before = gravity_on(model, prev%gravity, elset, prev%period, step_start)
          after = gravity_on(model, now%gravity, elset, 0.0_dp, step_start)
+         ! (a load carried over keeps its value, so a jump comes from a definition in step s)
          scale = max(norm2(before), norm2(after))
          if (.not. (norm2(after - before) > 1.0e-9_dp * scale)) cycle
          if (any(now%gravity%elset == elset)) then
@@ -58,7 +59,7 @@ contains
     end associate
   end subroutine warn_gravity_jumps
 
-  !> The gravity vector of the loads on one element set at the given times.
+  !> The gravity vector of the loads on one element set at the given step and total time.
   function gravity_on(model, loads, elset, step_time, total_time) result(g)
     type(model_t), intent(in) :: model
     type(gravity_t), intent(in) :: loads(:)
@@ -71,7 +72,7 @@ contains
     do k = 1, size(loads)
        if (loads(k)%elset /= elset) cycle
        g = g + loads(k)%magnitude * loads(k)%direction * &
-            variation_factor(loads(k)%variation, model%amplitudes, step_time, total_time + step_time)
+            variation_factor(loads(k)%variation, model%amplitudes, step_time, total_time)
     end do
   end function gravity_on
 

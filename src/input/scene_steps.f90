@@ -331,7 +331,9 @@ contains
     call blk%check_params([character(len=9) :: 'AMPLITUDE', 'OP'], err)
     if (.not. err%raised) call boundary_op(blk, op, err)
     if (.not. err%raised) call amplitude_param(blk, model, amp, err)
-    if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'element set or blank, GRAV, g, nx, ny[, nz]', err)
+    ! OP=NEW without data lines removes every gravity load (Abaqus)
+    if (.not. err%raised) call expect_lines(blk, merge(0, 1, op == 'NEW'), huge(1), &
+         'element set or blank, GRAV, g, nx, ny[, nz]', err)
     if (err%raised) return
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
