@@ -24,7 +24,7 @@ program bulkflow
   type(run_options_t) :: opts
   character(len=:), allocatable :: scene
   logical :: check_only
-  integer :: rank, nranks
+  integer :: rank, nranks, iw
 
   call MPI_Init()
   call MPI_Comm_rank(MPI_COMM_WORLD, rank)
@@ -38,6 +38,11 @@ program bulkflow
 
   call read_scene(scene, m, err)
   if (err%raised) call input_error_exit(err)
+  if (rank == 0 .and. allocated(m%warnings)) then
+     do iw = 1, size(m%warnings)
+        write (error_unit, '(a)') 'bulkflow: warning: ' // trim(m%warnings(iw))
+     end do
+  end if
   if (check_only) then
      if (rank == 0 .and. m%mpm%active) then
         write (output_unit, '(a,i0,a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (material points, ', &

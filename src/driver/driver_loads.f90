@@ -6,6 +6,7 @@ module driver_loads
   use material_kinds, only: dp
   use model, only: model_t
   use model_steps, only: bc_velocity
+  use model_time_variation, only: time_variation_t, variation_factor, variation_is_constant
   use model_sets, only: sorted_position
   use parallel_partition, only: partition_t, local_node_index, local_elem_index
   use parallel_assembly, only: assemble_element_vectors
@@ -16,13 +17,14 @@ module driver_loads
 
   type :: prescribed_t
      integer :: node = 0, dof = 0            !< local node (or rigid surface for rigid lists)
-     integer :: kind = 0, amplitude = 0
+     integer :: kind = 0
+     type(time_variation_t) :: variation
      real(dp) :: value = 0
   end type prescribed_t
 
   type :: gravity_local_t
      real(dp) :: g(3) = 0
-     integer :: amplitude = 0
+     type(time_variation_t) :: variation
      real(dp), allocatable :: mass(:)         !< (n_local_nodes) lumped mass of the loaded elements
   end type gravity_local_t
 
@@ -44,7 +46,7 @@ module driver_loads
   end type step_loads_t
 
   public :: prepare_step, apply_prescribed_velocities, apply_rigid_body_velocities, gravity_forces, &
-       apply_contact
+       apply_contact, gravity_varies_in_step
 
 contains
 
@@ -80,7 +82,7 @@ contains
                     do r = 1, m%n_rigid_surfaces
                        if (m%rigid_surfaces(r)%ref_node == b%nodes(i)) then
                           nr = nr + 1
-                          loads%rigid(nr) = prescribed_t(r, dof, b%kind, b%amplitude, b%value)
+                          loads%rigid(nr) = prescribed_t(r, dof, b%kind, b%variation, b%value)
                           found = .true.
                        end if
                     end do
@@ -88,7 +90,7 @@ contains
                     k = local_node_index(part, b%nodes(i))
                     if (k == 0) cycle
                     n = n + 1
-                    loads%prescribed(n) = prescribed_t(k, dof, b%kind, b%amplitude, b%value)
+                    loads%prescribed(n) = prescribed_t(k, dof, b%kind, b%variation, b%value)
                     solver%fixed(dof, k) = .true.
                  end do
               end do
@@ -120,7 +122,7 @@ contains
             call assemble_element_vectors(part, 1, fe, gm)
             loads%gravity(g)%mass = gm(1, :)
             loads%gravity(g)%g = s%gravity(g)%magnitude * s%gravity(g)%direction
-            loads%gravity(g)%amplitude = s%gravity(g)%amplitude
+            loads%gravity(g)%variation = s%gravity(g)%variation
          end do
       else
          allocate(loads%gravity(0))
@@ -201,7 +203,7 @@ contains
 
     do i = 1, loads%n_prescribed
        associate (p => loads%prescribed(i))
-         call amplitudes(m, p%amplitude, solver%step_start, step_time_mid, step_time_new, amp_mid, amp_new)
+         call amplitudes(m, p%variation, solver%step_start, step_time_mid, step_time_new, amp_mid, amp_new)
          if (p%kind == bc_velocity) then
             solver%v(p%dof, p%node) = p%value * amp_mid
          else
@@ -226,7 +228,7 @@ contains
     end do
     do i = 1, loads%n_rigid
        associate (p => loads%rigid(i), body => solver%rigid(loads%rigid(i)%node))
-         call amplitudes(m, p%amplitude, solver%step_start, step_time_mid, step_time_new, amp_mid, amp_new)
+         call amplitudes(m, p%variation, solver%step_start, step_time_mid, step_time_new, amp_mid, amp_new)
          if (p%kind == bc_velocity) then
             body%v(p%dof) = p%value * amp_mid
          else
@@ -236,21 +238,17 @@ contains
     end do
   end subroutine apply_rigid_body_velocities
 
-  !> Amplitude factors at the middle and the end of the increment; no amplitude: 1 (Abaqus's
-  !> step amplitude for displacement and velocity boundary conditions in Explicit).
-  subroutine amplitudes(m, id, step_start, t_mid, t_new, a_mid, a_new)
+  !> Factors at the middle and the end of the increment (model_time_variation: no amplitude
+  !> gives 1, Abaqus's step variation in Explicit; a condition carried over with a step-time
+  !> amplitude its held value).
+  subroutine amplitudes(m, variation, step_start, t_mid, t_new, a_mid, a_new)
     type(model_t), intent(in) :: m
-    integer, intent(in) :: id
+    type(time_variation_t), intent(in) :: variation
     real(dp), intent(in) :: step_start, t_mid, t_new
     real(dp), intent(out) :: a_mid, a_new
 
-    if (id == 0) then
-       a_mid = 1
-       a_new = 1
-    else
-       a_mid = m%amplitudes(id)%value(t_mid, step_start + t_mid)
-       a_new = m%amplitudes(id)%value(t_new, step_start + t_new)
-    end if
+    a_mid = variation_factor(variation, m%amplitudes, t_mid, step_start + t_mid)
+    a_new = variation_factor(variation, m%amplitudes, t_new, step_start + t_new)
   end subroutine amplitudes
 
   !> f_ext = Σ gravity loads at the given step time.
@@ -265,14 +263,24 @@ contains
 
     f_ext = 0
     do g = 1, size(loads%gravity)
-       amp = 1
-       if (loads%gravity(g)%amplitude > 0) amp = m%amplitudes(loads%gravity(g)%amplitude)%value(step_time, &
-            solver%step_start + step_time)
+       amp = variation_factor(loads%gravity(g)%variation, m%amplitudes, step_time, solver%step_start + step_time)
        do i = 1, solver%n_nodes
           f_ext(:, i) = f_ext(:, i) + loads%gravity(g)%mass(i) * amp * loads%gravity(g)%g(1:solver%ndim)
        end do
     end do
   end subroutine gravity_forces
+
+  !> Does a gravity load of the step change within the step (f_ext must be formed anew)?
+  pure logical function gravity_varies_in_step(loads)
+    type(step_loads_t), intent(in) :: loads
+    integer :: g
+
+    gravity_varies_in_step = .false.
+    if (.not. allocated(loads%gravity)) return
+    do g = 1, size(loads%gravity)
+       if (.not. variation_is_constant(loads%gravity(g)%variation)) gravity_varies_in_step = .true.
+    end do
+  end function gravity_varies_in_step
 
   !> Kinematic contact of every active pair on v_{n+1/2}. Two passes settle nodes held by two
   !> walls (a concave corner: hopper wall and outlet plate). Returns the frictional work of this

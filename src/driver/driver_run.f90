@@ -17,7 +17,7 @@ module driver_run
   use driver_setup, only: setup_solver, initial_internal_forces
   use driver_elements, only: element_workspace_t, element_workspace_init, element_phase
   use driver_loads, only: step_loads_t, prepare_step, apply_prescribed_velocities, &
-       apply_rigid_body_velocities, gravity_forces, apply_contact
+       apply_rigid_body_velocities, gravity_forces, apply_contact, gravity_varies_in_step
   use driver_output, only: run_output_t, open_run_output, close_run_output, step_output_start, &
        output_due, write_frame, write_history, energy_values, progress_line, field_interval, &
        history_interval, sum_over_ranks
@@ -243,7 +243,7 @@ contains
       ! step start, or read from the checkpoint) stays, and f_ext_old is f_ext. Recomputing it
       ! gave the same numbers at the cost of two passes over the nodes. (Code that changes the
       ! gravity loads within a step must call gravity_forces itself.)
-      gravity_varies = effects%active(effect_gravity) .and. gravity_has_amplitude(loads)
+      gravity_varies = effects%active(effect_gravity) .and. gravity_varies_in_step(loads)
       if (gravity_varies) then
          solver%f_ext_old = solver%f_ext
          call effects%start(effect_gravity)
@@ -506,18 +506,6 @@ contains
     a = merge(quotient, 0.0_dp, mass > 0 .and. .not. fixed)
     reaction = merge(f_int - f_ext, 0.0_dp, fixed)
   end subroutine dof_acceleration
-
-  !> Does a gravity load of the step have an amplitude (f_ext changes within the step)?
-  pure logical function gravity_has_amplitude(loads)
-    type(step_loads_t), intent(in) :: loads
-    integer :: g
-
-    gravity_has_amplitude = .false.
-    if (.not. allocated(loads%gravity)) return
-    do g = 1, size(loads%gravity)
-       if (loads%gravity(g)%amplitude > 0) gravity_has_amplitude = .true.
-    end do
-  end function gravity_has_amplitude
 
   subroutine write_outputs(m, solver, out, effects, istep)
     type(model_t), intent(in) :: m

@@ -14,6 +14,8 @@ module scene_boundaries
   use keyword_reader, only: keyword_block_t, data_line_t, is_integer_text
   use model, only: model_t
   use model_steps, only: boundary_t, bc_displacement, bc_velocity
+  use model_amplitudes, only: amplitude_t
+  use model_time_variation, only: time_variation_t, carry_into_step
   use scene_amplitudes, only: amplitude_param
   use scene_sets, only: node_targets
   use scene_util, only: itoa, get_int, get_real, field_name, last_field, expect_lines, &
@@ -21,16 +23,17 @@ module scene_boundaries
   implicit none
   private
 
-  public :: bc_state_t, bc_init, bc_clear, read_boundary, bc_resolve, boundary_op
+  public :: bc_state_t, bc_init, bc_clear, read_boundary, bc_resolve, boundary_op, bc_carry
 
   !> Active conditions as (node, dof) atoms; `owner(dof, node)` is the live atom or 0.
   type :: bc_state_t
      integer :: n = 0
-     integer, allocatable :: node(:), dof(:), kind(:), amp(:), src(:)
+     integer, allocatable :: node(:), dof(:), kind(:), src(:)
      real(dp), allocatable :: value(:)
      integer, allocatable :: owner(:, :)
      integer :: n_src = 0
      character(len=256), allocatable :: src_text(:)    !< file:line of each data line used
+     type(time_variation_t), allocatable :: src_var(:)  !< time variation of each data line's conditions
   end type bc_state_t
 
 contains
@@ -39,10 +42,24 @@ contains
     type(bc_state_t), intent(out) :: st
     integer, intent(in) :: n_nodes
 
-    allocate (st%node(64), st%dof(64), st%kind(64), st%amp(64), st%src(64), st%value(64))
-    allocate (st%owner(3, n_nodes), st%src_text(16))
+    allocate (st%node(64), st%dof(64), st%kind(64), st%src(64), st%value(64))
+    allocate (st%owner(3, n_nodes), st%src_text(16), st%src_var(16))
     st%owner = 0
   end subroutine bc_init
+
+  !> At the start of a step: every condition carried over from the step before (`period` long,
+  !> ending at total time `step_end`) follows Abaqus's rule for conditions not defined again
+  !> (model_time_variation); conditions the step defines again replace their atoms afterwards.
+  pure subroutine bc_carry(st, amplitudes, period, step_end)
+    type(bc_state_t), intent(inout) :: st
+    type(amplitude_t), intent(in) :: amplitudes(:)
+    real(dp), intent(in) :: period, step_end
+    integer :: k
+
+    do k = 1, st%n_src
+       call carry_into_step(st%src_var(k), amplitudes, period, step_end)
+    end do
+  end subroutine bc_carry
 
   !> OP=NEW: no condition stays active.
   subroutine bc_clear(st)
@@ -87,7 +104,9 @@ contains
             'expected them on a *BOUNDARY inside a step', err)
        return
     end if
-    call expect_lines(blk, 1, huge(1), 'node or node set, first dof[, last dof[, value]]', err)
+    ! OP=NEW without data lines removes every boundary condition (Abaqus)
+    call expect_lines(blk, merge(0, 1, op == 'NEW'), huge(1), &
+         'node or node set, first dof[, last dof[, value]]', err)
     if (err%raised) return
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
@@ -151,15 +170,19 @@ contains
     real(dp), intent(in) :: value
     character(len=*), intent(in) :: source
     character(len=256), allocatable :: ttmp(:)
+    type(time_variation_t), allocatable :: vtmp(:)
     integer :: i, d
 
     if (st%n_src >= size(st%src_text)) then
-       allocate (ttmp(2 * size(st%src_text)))
+       allocate (ttmp(2 * size(st%src_text)), vtmp(2 * size(st%src_text)))
        ttmp(1:st%n_src) = st%src_text(1:st%n_src)
+       vtmp(1:st%n_src) = st%src_var(1:st%n_src)
        call move_alloc(ttmp, st%src_text)
+       call move_alloc(vtmp, st%src_var)
     end if
     st%n_src = st%n_src + 1
     st%src_text(st%n_src) = source
+    st%src_var(st%n_src) = time_variation_t(amplitude=amp)
     call compact(st)
     do d = first, last
        do i = 1, size(nodes)
@@ -170,7 +193,6 @@ contains
           st%dof(st%n) = d
           st%kind(st%n) = kind
           st%value(st%n) = value
-          st%amp(st%n) = amp
           st%src(st%n) = st%n_src
           st%owner(d, nodes(i)) = st%n
        end do
@@ -191,7 +213,6 @@ contains
        st%dof(m) = st%dof(i)
        st%kind(m) = st%kind(i)
        st%value(m) = st%value(i)
-       st%amp(m) = st%amp(i)
        st%src(m) = st%src(i)
        st%owner(st%dof(m), st%node(m)) = m
     end do
@@ -207,7 +228,6 @@ contains
     call grow_int(st%node, m)
     call grow_int(st%dof, m)
     call grow_int(st%kind, m)
-    call grow_int(st%amp, m)
     call grow_int(st%src, m)
     block
       real(dp), allocatable :: tmp(:)
@@ -265,7 +285,7 @@ contains
        list(nb)%last_dof = st%dof(a)
        list(nb)%kind = st%kind(a)
        list(nb)%value = st%value(a)
-       list(nb)%amplitude = st%amp(a)
+       list(nb)%variation = st%src_var(st%src(a))
        list(nb)%source = st%src_text(st%src(a))
        bsrc(nb) = st%src(a)
        if (nb > 1) then

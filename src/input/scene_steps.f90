@@ -6,6 +6,10 @@
 !>   later steps; OP=MOD (default for *BOUNDARY and *DLOAD) replaces what the new lines
 !>   name, OP=NEW drops everything inherited (it must then be on every *BOUNDARY or
 !>   *DLOAD of the step, as in Abaqus); *CONTACT PAIR, OP=DELETE removes a pair;
+!> * a boundary condition or load carried over without being defined again keeps following
+!>   an amplitude in total time and is held at its last value when its amplitude is in step
+!>   time (model_time_variation); gravity that jumps at a step start is warned about
+!>   (scene_step_continuity);
 !> * *BULK VISCOSITY and *RESTART, WRITE stay in effect until changed;
 !> * *DYNAMIC, SCALE FACTOR= and DIRECT USER CONTROL belong to their step only;
 !> * *FIXED MASS SCALING carries over to later steps (Abaqus); a step with its own definitions
@@ -23,7 +27,10 @@ module scene_steps
        mass_scaling_uniform
   use scene_layout, only: scene_layout_t
   use scene_amplitudes, only: amplitude_param
-  use scene_boundaries, only: bc_state_t, bc_init, bc_clear, read_boundary, bc_resolve, boundary_op
+  use scene_boundaries, only: bc_state_t, bc_init, bc_clear, read_boundary, bc_resolve, boundary_op, &
+       bc_carry
+  use scene_step_continuity, only: warn_gravity_jumps
+  use model_time_variation, only: time_variation_t, carry_into_step
   use scene_outputs, only: output_state_t, outputs_step_start, read_output, read_output_option, time_marks
   use scene_surfaces, only: find_element_surface, find_rigid_surface
   use scene_interactions, only: find_interaction
@@ -58,7 +65,8 @@ contains
     type(model_t), intent(inout) :: model
     type(error_t), intent(inout) :: err
     type(carry_t) :: c
-    integer :: i, s
+    integer :: i, s, k
+    real(dp) :: step_end
 
     call bc_init(c%bcs, model%mesh%n_nodes)
     allocate (c%gravity(0), c%pairs(0), c%mass_scaling(0))
@@ -81,9 +89,20 @@ contains
     end if
     model%n_steps = layout%n_steps
     allocate (model%steps(model%n_steps))
+    step_end = 0
     do s = 1, model%n_steps
+       if (s > 1) then
+          ! what the step does not define again is carried over (Abaqus's rules)
+          call bc_carry(c%bcs, model%amplitudes, model%steps(s - 1)%period, step_end)
+          do k = 1, c%n_gravity
+             call carry_into_step(c%gravity(k)%variation, model%amplitudes, model%steps(s - 1)%period, &
+                  step_end)
+          end do
+       end if
        call read_step(deck, layout, s, model, c, model%steps(s), err)
        if (err%raised) return
+       if (s > 1) call warn_gravity_jumps(model, s, step_end)
+       step_end = step_end + model%steps(s)%period
     end do
   end subroutine build_steps
 
@@ -312,7 +331,9 @@ contains
     call blk%check_params([character(len=9) :: 'AMPLITUDE', 'OP'], err)
     if (.not. err%raised) call boundary_op(blk, op, err)
     if (.not. err%raised) call amplitude_param(blk, model, amp, err)
-    if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'element set or blank, GRAV, g, nx, ny[, nz]', err)
+    ! OP=NEW without data lines removes every gravity load (Abaqus)
+    if (.not. err%raised) call expect_lines(blk, merge(0, 1, op == 'NEW'), huge(1), &
+         'element set or blank, GRAV, g, nx, ny[, nz]', err)
     if (err%raised) return
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
@@ -325,7 +346,8 @@ contains
             return
          end if
          g = gravity_t()
-         g%amplitude = amp
+         g%variation = time_variation_t(amplitude=amp)
+         g%source = where_text(dl%file, dl%line)
          if (.not. field_blank(dl, 1)) then
             name = field_name(dl, 1)
             if (is_integer_text(name)) then

@@ -55,6 +55,7 @@ module model
      type(step_t), allocatable :: steps(:)
      type(mpm_scene_t) :: mpm                 !< material-point part (active with *MPM GRID)
      type(scene_digest_t) :: digest           !< the deck's lines, hashed (restarts check it)
+     character(len=1024), allocatable :: warnings(:)  !< "file:line: what" found while building
   end type model_t
 
   public :: name_length

@@ -1,10 +1,12 @@
 !> Analysis steps (*STEP ... *END STEP) with everything active in them. The model builder
 !> resolves Abaqus's propagation rules (boundary conditions, loads, contact pairs and output
-!> requests carry over to later steps unless replaced with OP=NEW or removed with OP=DELETE),
-!> so each step_t holds its complete active set and the driver never looks back.
+!> requests carry over to later steps unless replaced with OP=NEW or removed with OP=DELETE;
+!> a carried condition's time variation follows model_time_variation), so each step_t holds
+!> its complete active set and the driver never looks back.
 module model_steps
   use material_kinds, only: dp
   use model_sets, only: name_length
+  use model_time_variation, only: time_variation_t
   implicit none
   private
 
@@ -12,13 +14,13 @@ module model_steps
   integer, parameter, public :: bc_velocity = 2
 
   !> *BOUNDARY on nodes: dofs first_dof..last_dof (1..ndim) fixed to `value` times the
-  !> amplitude (displacement: total displacement; velocity: velocity).
+  !> time variation's factor (displacement: total displacement; velocity: velocity).
   type, public :: boundary_t
      integer, allocatable :: nodes(:)         !< internal node indices
      integer :: first_dof = 1, last_dof = 1
      integer :: kind = bc_displacement
      real(dp) :: value = 0
-     integer :: amplitude = 0                 !< index into model%amplitudes, 0: ramp-free constant
+     type(time_variation_t) :: variation      !< amplitude, or held from an earlier step
      character(len=256) :: source = ''
   end type boundary_t
 
@@ -27,7 +29,8 @@ module model_steps
      integer :: elset = 0
      real(dp) :: magnitude = 0
      real(dp) :: direction(3) = 0
-     integer :: amplitude = 0
+     type(time_variation_t) :: variation      !< amplitude, or held from an earlier step
+     character(len=256) :: source = ''        !< file:line of the *DLOAD data line
   end type gravity_t
 
   !> *SURFACE INTERACTION + *FRICTION.

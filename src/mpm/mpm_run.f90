@@ -32,6 +32,7 @@ module mpm_run
   use error_report, only: error_t, raise_error
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
+  use model_time_variation, only: variation_factor
   use mpm_scene, only: mpm_scene_t, particle_region_t, mpm_inflow_t, region_box, region_polygon
   use mpm_grid, only: grid_t, grid_init, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_keep, block_grow
@@ -668,17 +669,14 @@ contains
 
     s = st%step
     t_new = st%step_time + st%dt
-    ! gravity of the step at the end of the increment (as the element driver takes loads)
+    ! gravity of the step at the end of the increment (as the element driver takes loads; a
+    ! load carried over from an earlier step keeps its value: model_time_variation)
     st%gravity = 0
     if (allocated(m%steps(s)%gravity)) then
        do k = 1, size(m%steps(s)%gravity)
           associate (gl => m%steps(s)%gravity(k))
-            if (gl%amplitude > 0) then
-               st%gravity = st%gravity + gl%magnitude * gl%direction * &
-                    m%amplitudes(gl%amplitude)%value(t_new, st%total_time + st%dt)
-            else
-               st%gravity = st%gravity + gl%magnitude * gl%direction
-            end if
+            st%gravity = st%gravity + gl%magnitude * gl%direction * &
+                 variation_factor(gl%variation, m%amplitudes, t_new, st%total_time + st%dt)
           end associate
        end do
     end if

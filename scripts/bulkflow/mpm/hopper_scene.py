@@ -2,7 +2,8 @@
 
 Half model (symmetry plane x = 0), plane strain: apex at the origin, walls at the hopper
 half-angle theta from the vertical, outlet of full width b at y0 = (b/2)/tan(theta), fill height H
-above the outlet. Step FILL: outlet closed (a frictional wall), gravity ramped smoothly, light
+above the outlet. Step FILL: outlet closed (a frictional wall), gravity ramped smoothly (in total time:
+it stays on in the discharge step), light
 local damping so the fill comes to rest. Step DISCHARGE: the outlet wall is deleted, particles
 falling 2 cells below the outlet leave (*OUTFLOW), optional *INFLOW keeps the top level.
 
@@ -122,7 +123,11 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu:.7f}")
     w(f"{lo[0]:.9f}, {y0:.9f}, {0.5 * outlet:.9f}, {y0:.9f}")
     w(f"*OUTFLOW, BELOW={out_level:.9f}")
-    w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP")
+    # Gravity that stays on: the ramp runs in total time, so the discharge step, which does not
+    # define gravity again, carries it on at full value (docs/keywords.md, "Prescribed conditions
+    # across steps"; with TIME=STEP TIME it would be held at the ramp's end value, the same here).
+    w("** gravity: ramped in the fill step, then on at full value (amplitude in total time)")
+    w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME")
     w(f"0., 0., {ramp:g}, 1.")
     w("*STEP, NAME=FILL")
     w("Outlet closed: the fill settles under gravity")
