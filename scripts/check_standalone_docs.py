@@ -7,6 +7,9 @@ primary source. This check finds citations of outside notes: the working notes t
 started from (numerics.md, hopper_theory.md, abaqus_interfaces.md, anchors.md, design.md,
 thesis.md, anything under reference/ or shared/), and any path that leaves the tree through
 ../shared or names /work/. A note of that name inside docs/theory/ is ours and allowed.
+It also keeps the section anchors of docs/theory/ stable: a citation such as
+`docs/theory/mpm.md §4.2` (or `mpm.md §4.2` from inside docs/theory/) must name a section
+heading that exists in that file ("## 4. MPM", "### 4.2 ...", "## (d) ...", "### d.3 ...").
 
 Usage: check_standalone_docs.py [--root DIR] [FILE ...]
   With no FILE, every file git tracks under DIR (default: the repository holding this script)
@@ -34,6 +37,10 @@ PATTERNS = [
 
 #: Files that must spell the forbidden patterns out: this check and its test.
 SELF = {"scripts/check_standalone_docs.py", "tests/docs/test_check_standalone_docs.py"}
+
+THEORY = "docs/theory"
+CITATION = re.compile(r"(docs/theory/)?\b(\w+\.md)`?\)?\s*((?:§\s*[\w.]+(?:[–-][\w.]+)?(?:,\s*|/)?)+)")
+HEADING = re.compile(r"#+\s*(?:\((\w+)\)|(\w+(?:\.\w+)*)\.?)\s")
 
 SKIP_DIRS = {".git", "build", "build-debug", ".venv", "__pycache__"}
 
@@ -64,7 +71,37 @@ def is_sibling(root, rel, cited):
     return os.path.isfile(os.path.join(root, os.path.dirname(rel), cited))
 
 
-def check_file(root, rel):
+def theory_sections(root):
+    """{file name: set of section labels} of the docs/theory/*.md files under root."""
+    sections = {}
+    folder = os.path.join(root, THEORY)
+    if os.path.isdir(folder):
+        for name in sorted(os.listdir(folder)):
+            if name.endswith(".md"):
+                with open(os.path.join(folder, name), encoding="utf-8", errors="replace") as fh:
+                    sections[name] = {(m.group(1) or m.group(2)) for m in map(HEADING.match, fh) if m}
+    return sections
+
+
+def missing_sections(rel, line, sections):
+    """Citations of docs/theory sections on this line whose section heading does not exist."""
+    missing = []
+    for m in CITATION.finditer(line):
+        prefixed, name, secs = m.group(1), m.group(2), m.group(3)
+        if not prefixed and os.path.dirname(rel) != THEORY:
+            continue  # a bare file name outside docs/theory is some other file
+        if name not in sections:
+            if prefixed:
+                missing.append(f"{THEORY}/{name} (no such file)")
+            continue
+        for sec in re.findall(r"§\s*([\w.]+)", secs):
+            sec = sec.rstrip(".")
+            if sec not in sections[name]:
+                missing.append(f"{THEORY}/{name} §{sec}")
+    return missing
+
+
+def check_file(root, rel, sections=None):
     """(line number, text, reason) of every outside citation in one file; binary files give none."""
     path = os.path.join(root, rel)
     try:
@@ -76,6 +113,8 @@ def check_file(root, rel):
         return []
     hits = []
     for number, line in enumerate(data.decode("utf-8", "replace").splitlines(), start=1):
+        for cited in missing_sections(rel, line, sections or {}):
+            hits.append((number, line.strip(), f"cited section does not exist: {cited}"))
         for pattern, reason in PATTERNS:
             if any(not is_sibling(root, rel, m.group(0)) for m in pattern.finditer(line)):
                 hits.append((number, line.strip(), reason))
@@ -94,17 +133,19 @@ def main(argv=None):
         print(f"check_standalone_docs: {root}: not a directory", file=sys.stderr)
         return 2
     files = args.files or tracked_files(root)
+    sections = theory_sections(root)
     count = 0
     for rel in files:
         rel = os.path.relpath(os.path.join(root, rel), root).replace(os.sep, "/")
         if rel in SELF:
             continue
-        for number, text, reason in check_file(root, rel):
+        for number, text, reason in check_file(root, rel, sections):
             print(f"{rel}:{number}: {reason}: {text}")
             count += 1
     if count:
-        print(f"check_standalone_docs: {count} citation(s) of notes outside the repository; "
-              "write the fact in docs/theory/ (with its primary source) and cite that section",
+        print(f"check_standalone_docs: {count} citation(s) of notes outside the repository or of "
+              "missing docs/theory sections; "
+              "write the fact in docs/theory/ (with its primary source) and cite a section that exists",
               file=sys.stderr)
         return 1
     print(f"check_standalone_docs: {len(files)} files, no citation of notes outside the repository")

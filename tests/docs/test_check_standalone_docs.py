@@ -55,8 +55,10 @@ class CheckStandaloneDocs(unittest.TestCase):
             with open(os.path.join(root, "code.py"), "w", encoding="utf-8") as fh:
                 fh.write("\n".join(GOOD) + "\n")
             # a sibling link inside docs/theory is a link within the repository
-            for name, text in (("hopper_theory.md", "# ours\n"),
-                               ("mpm.md", "Janssen saturation (`hopper_theory.md §f`)\n")):
+            for name, text in (("hopper_theory.md", "# ours\n## (c) Jenike\n### c.2 Arch\n## (f) Janssen\n"),
+                               ("abaqus_contract.md", "# ours\n## 0. What the host must do\n"),
+                               ("mpm.md", "## 4. MPM\n### 4.2 GIMP\nJanssen saturation "
+                                          "(`hopper_theory.md §f`)\n")):
                 with open(os.path.join(root, "docs", "theory", name), "w", encoding="utf-8") as fh:
                     fh.write(text)
             result = run(root)
@@ -70,6 +72,20 @@ class CheckStandaloneDocs(unittest.TestCase):
             result = run(root, "docs/x.md")
             self.assertEqual(result.returncode, 1)
             self.assertIn("docs/x.md:2:", result.stdout)
+
+    def test_a_citation_of_a_missing_section_is_refused(self):
+        with tempfile.TemporaryDirectory() as root:
+            os.makedirs(os.path.join(root, "docs", "theory"))
+            with open(os.path.join(root, "docs", "theory", "mpm.md"), "w", encoding="utf-8") as fh:
+                fh.write("# MPM\n\n## 4. MPM\n\n### 4.2 GIMP\n\nsee `mpm.md §4.3`\n")
+            with open(os.path.join(root, "a.f90"), "w", encoding="utf-8") as fh:
+                fh.write("! docs/theory/mpm.md §4.2 exists\n! docs/theory/mpm.md §4, §4.7 does not\n"
+                         "! docs/theory/nothing.md §1\n")
+            result = run(root)
+            self.assertEqual(result.returncode, 1)
+            lines = sorted(line.split(": ")[0] for line in result.stdout.splitlines())
+            self.assertEqual(lines, ["a.f90:2", "a.f90:3", "docs/theory/mpm.md:7"], result.stdout)
+            self.assertIn("mpm.md §4.7", result.stdout)
 
     def test_missing_root_is_a_usage_error(self):
         self.assertEqual(run("/nonexistent-bulkflow-root").returncode, 2)
