@@ -1,7 +1,7 @@
 !> Plane-strain matching between Mohr–Coulomb (φ, ψ, c) and linear Drucker–Prager in the Abaqus
 !> q-form (F = q − p tanβ − d, G = q − p tanψ_DP, K = 1), and its inverse. Angles in radians.
 !>
-!> The match (numerics.md §2.2; the Abaqus manual's relation): in plane strain at steady plastic
+!> The match (docs/theory/return_mapping.md §2.2; the Abaqus manual's relation): in plane strain at steady plastic
 !> flow the elastic strain rate vanishes, so ε̇zz^p = 0, i.e. ∂G/∂σzz = 0 ⇒ szz = −(2/9) q tanψ_DP.
 !> With the in-plane radius τ = (σ1 − σ3)/2 and centre σ̄ = (σ1 + σ3)/2 this gives
 !>   q = 3√3 τ / √(9 − tan²ψ_DP),  p = −σ̄ + q tanψ_DP/9,

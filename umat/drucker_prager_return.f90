@@ -7,7 +7,7 @@
 !> on Abaqus-ordered component vectors (ncomp = 4: 11, 22, 33, 12 with σ33 carried, plane strain or
 !> axisymmetry; ncomp = 6: 11, 22, 33, 12, 23, 31), tension positive, tensor shear strains.
 !>
-!> Derivation (q-form; numerics.md §2.3 gives the same algorithm in the √J2 form: with q = √3 √J2,
+!> Derivation (q-form; docs/theory/return_mapping.md §2.3 gives the same algorithm in the √J2 form: with q = √3 √J2,
 !> f = F/√3, η = tanβ/√3, η̄ = tanψ/√3, ξc = d/√3 and Δγ = √3 Δλ, its Δγ = f*/(G + K η η̄) is
 !> exactly the Δλ below, and its apex σm = ξc/η is the σ_a below):
 !>   ∂G/∂σ = (3/2) s/q + (tanψ/3) I, so Δε^p = Δλ ∂G/∂σ has

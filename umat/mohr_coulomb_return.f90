@@ -2,7 +2,7 @@
 !> stress space, with non-associated flow and an optional associated Rankine tension cut-off.
 !>
 !> This module owns the return-region logic of Clausen, Damkilde & Andersen (Comput. Struct. 85,
-!> 2007; numerics.md §1.2): plane, edge σ1=σ2 (compression meridian, l1 = (1,1,k)), edge σ2=σ3
+!> 2007; docs/theory/return_mapping.md §1.2): plane, edge σ1=σ2 (compression meridian, l1 = (1,1,k)), edge σ2=σ3
 !> (extension meridian, l2 = (1,k,k)) and apex, and the cut-off regions (Rankine plane σ1 = σt,
 !> Rankine edge σ1=σ2=σt, MC∩Rankine line and its two corners, Rankine apex σ = σt(1,1,1)).
 !>
@@ -22,20 +22,20 @@
 !>    for φ ≤ 55° the two differ by less than a factor 10.
 !>
 !> ψ = 0: with m = 1 the dilatancy term g_d = λ(m−1) is exactly zero, and every general formula
-!> below reduces *identically* to the closed forms of numerics.md §1.3 (r ∝ (1,0,−1),
+!> below reduces *identically* to the closed forms of docs/theory/return_mapping.md §1.3 (r ∝ (1,0,−1),
 !> t1 ∝ 3(p−σa)/(2+k), t2 ∝ 3(p−σa)/(1+2k)); all denominators are sums of positive terms for
 !> every ψ in [0, φ] and every λ > −2G/3 (bulk modulus > 0), so no ψ = 0 branch is needed.
 !>
 !> Apex: the region test is Clausen's (t1 > 0 and t2 > 0). For ψ > 0 and trial states in the
 !> cone of the corrector directions this is the KKT apex return; for ψ = 0 (and for small ψ with
 !> trial states far on the tensile side) no plastic corrector of the flow rule can reach the
-!> surface, and the apex is taken by definition ("tensile separation", numerics.md §1.3), with a
+!> surface, and the apex is taken by definition ("tensile separation", docs/theory/return_mapping.md §1.3), with a
 !> volumetric plastic strain even for ψ = 0.
 !>
 !> The plain Mohr–Coulomb path is closed form (about 10-20 ns per call) and small enough to
 !> inline into a block loop. The cut-off is entered only when the Mohr–Coulomb result violates
 !> σ1 ≤ σt: the Rankine return alone in closed form (about 25 ns), and only where Mohr–Coulomb is
-!> active as well an active-set solve over the candidate plane sets (numerics.md §1.7).
+!> active as well an active-set solve over the candidate plane sets (docs/theory/return_mapping.md §1.7).
 !> mohr_coulomb_return_block is the same return on up to block_points points at once, in one
 !> branch-free loop that gfortran vectorises, with the same results bit for bit (the cut-off,
 !> where active, goes through the scalar routine in a second pass).
@@ -137,7 +137,7 @@ contains
        ! Plastic corrector directions, written with ge = 2G, gh = 2Gm, gd = λ(m−1):
        !   D b   = (gd+gh, gd, gd−ge)            (main plane, b = (m,0,−1))
        !   aᵀD b = gd(k−1) + k·gh + ge > 0
-       ! Normals of the region boundaries (numerics.md §1.2, scaled by positive factors, which
+       ! Normals of the region boundaries (docs/theory/return_mapping.md §1.2, scaled by positive factors, which
        ! changes no sign and no ratio):
        !   n1 ∝ r × r2 = (ge−gd, ge−gd, 2gd+gh),   t1 = n1·s / n1·l1
        !   n2 ∝ −r × r3 = (ge−2gd, gd+gh, gd+gh),  t2 = n2·s / n2·l2
@@ -327,7 +327,7 @@ contains
     m_of = (1.0_dp + sin_psi) / (1.0_dp - sin_psi)
   end function m_of
 
-  !> Combined Mohr–Coulomb + Rankine return in the sorted sextant (numerics.md §1.7).
+  !> Combined Mohr–Coulomb + Rankine return in the sorted sextant (docs/theory/return_mapping.md §1.7).
   !> Planes: 1 MC main (a = (k,0,−1), b = (m,0,−1)), 2 MC σ1=σ2 side (a = (0,k,−1)),
   !> 3 MC σ2=σ3 side (a = (k,−1,0)), 4..6 Rankine σ1, σ2, σ3 ≤ σt (associated, a = b = e_i).
   !>

@@ -3,7 +3,7 @@
 !> vumat and vusdfld are called through implicit interfaces, exactly as Abaqus calls user code,
 !> so a user's subroutine file links in place of ours. The first argument of vumat is
 !> jblock = [nblock, npt, layer, kspt, noel(1:nblock)] so both the scalar-nblock and the
-!> "jblock" styles of VUMAT work (reference/abaqus_interfaces.md §0). Times passed are those at
+!> "jblock" styles of VUMAT work (docs/theory/abaqus_contract.md §0). Times passed are those at
 !> the end of the increment; the packaging call has stepTime = totalTime = 0.
 !> With a user field, vusdfld runs first on the same block with the start-of-increment stress
 !> and logarithmic strain available to vgetvrm; its fields become the vumat's fieldNew and its

@@ -146,7 +146,7 @@ contains
   !> Characteristic length L_e = V / (largest face area) (LS-DYNA's choice for hexahedra),
   !> face area = ½|d1 × d2| from the face diagonals (exact for planar faces). L_e = h for a
   !> cube of side h, for which a uniform mesh of one-point elements has ω_max = 2c/h exactly
-  !> (numerics.md §3.6); a thin plate gives its thickness.
+  !> (docs/theory/elements.md §3.6); a thin plate gives its thickness.
   pure subroutine c3d8r_char_length(nb, xe, volume, char_length)
     integer, intent(in) :: nb
     real(dp), intent(in) :: xe(nb, 3, 8)

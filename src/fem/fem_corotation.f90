@@ -34,7 +34,7 @@ module fem_corotation
 
 contains
 
-  !> The whole corotational step of a block, in the order of abaqus_interfaces.md §1.4:
+  !> The whole corotational step of a block, in the order of docs/theory/abaqus_contract.md §1.4:
   !> F_{n+½}, F_{n+1} from the reference mean gradient; R_{n+½}, R_{n+1} by polar
   !> decomposition; strainInc = R_{n+½}ᵀ Δε R_{n+½}; relSpinInc. strain_inc, spin_inc: the
   !> global increments of <el>_strain_increment. r_old = R_n (element state, identity at the

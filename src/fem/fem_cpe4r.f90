@@ -55,7 +55,7 @@ contains
 
   !> Characteristic length L_e = A / (longest edge): the element height across its longest
   !> side (LS-DYNA's choice for quadrilaterals). L_e = h for a square of side h, for which a
-  !> uniform mesh of one-point elements has ω_max = 2c/h exactly (numerics.md §3.6), so
+  !> uniform mesh of one-point elements has ω_max = 2c/h exactly (docs/theory/elements.md §3.6), so
   !> Δt = L_e/c is the exact limit there; a thin a×b rectangle gives min(a, b).
   pure subroutine cpe4r_char_length(nb, xe, char_length)
     integer, intent(in) :: nb

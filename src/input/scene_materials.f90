@@ -290,7 +290,7 @@ contains
   end subroutine translate_mohr_coulomb
 
   !> DP props: E, nu, beta, psi, d, mode 0. d from the hardening's first row with K = 1
-  !> (abaqus_interfaces.md §5.2): compression d = (1 - tan(beta)/3) sigma_c,
+  !> (docs/theory/abaqus_contract.md §5.2): compression d = (1 - tan(beta)/3) sigma_c,
   !> shear d = sqrt(3) tau, tension d = (1 + tan(beta)/3) sigma_t.
   subroutine translate_drucker_prager(deck, mat, m, err)
     type(keyword_deck_t), intent(in) :: deck

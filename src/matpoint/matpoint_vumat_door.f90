@@ -5,7 +5,7 @@
 !> (`external`), exactly as Abaqus calls user code, so any VUMAT built against the same
 !> argument list links in its place (a user's file, fixed or free form). The first actual
 !> argument of vumat is the integer array jblock = [nblock, npt, layer, kspt, noel(1:nblock)]
-!> (reference/abaqus_interfaces.md §0 item 2): a VUMAT declaring a scalar `nblock` reads
+!> (docs/theory/abaqus_contract.md §0 item 2): a VUMAT declaring a scalar `nblock` reads
 !> jblock(1), one written in the "jblock" style finds its element numbers in jblock(5:).
 !>
 !> Before each vumat call of a material with `*USER DEFINED FIELD`, vusdfld is called on

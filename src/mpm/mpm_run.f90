@@ -1,4 +1,4 @@
-!> The explicit material-point solver (MUSL with a PIC/FLIP blend; numerics.md §4), one rank.
+!> The explicit material-point solver (MUSL with a PIC/FLIP blend; docs/theory/mpm.md §4), one rank.
 !>
 !> One increment (velocities at integer times, Δt from the grid size and the wave speed):
 !>   stencils     uGIMP or linear weights S_Ip and gradients ∇S_Ip at x_p^n       (mpm_shape)

@@ -4,7 +4,7 @@
 !>
 !> uGIMP keeps the particle half-length l fixed at its initial value h/(2 ppc) (the "u" of
 !> uGIMP): no domain update with F, so no domain can outgrow the 3-node stencil, and the
-!> kernel is the same for every particle of a block. numerics.md §4.2 has the 1D formulas.
+!> kernel is the same for every particle of a block. docs/theory/mpm.md §4.2 has the 1D formulas.
 !>
 !> Layout (block of nb particles, particle index first so the loops over a block vectorize):
 !> the 1D factors, not their products. corner(nb) is the global index (1-based) of the stencil's

@@ -1,4 +1,4 @@
-!> Rigid fixed walls on the background grid (numerics.md §4.4): after the grid momentum update
+!> Rigid fixed walls on the background grid (docs/theory/mpm.md §4.4): after the grid momentum update
 !> (and again after the MUSL remap) the velocity of every grid node on or behind an active wall
 !> is projected: a friction wall removes an approaching normal velocity and reduces the
 !> tangential one by μ |Δv_n| (Coulomb; stick when that exceeds it); a symmetry wall removes

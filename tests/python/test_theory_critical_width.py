@@ -1,5 +1,5 @@
 """Critical outlet widths: the thesis's Fig. 6.2 statements, McLean/Jenike identities and the
-reference numbers of hopper_theory.md §c, §i.2, §i.5."""
+reference numbers of docs/theory/hopper_theory.md §c, §i.2, §i.5."""
 import math
 
 import numpy as np
@@ -89,7 +89,7 @@ def test_thin_arch_theta_to_zero_is_eq_6_3():
 
 
 def test_jenike_beta_readings_and_case_B():
-    # Case B, φ_w = 0: β = ω gives 0 (no arch) while β = θ + ω gives 50.4 cm (hopper_theory §c.2)
+    # Case B, φ_w = 0: β = ω gives 0 (no arch) while β = θ + ω gives 50.4 cm (docs/theory/hopper_theory.md §c.2)
     e = est("B", 2.0)
     assert e["jenike_by_beta"]["omega"] == 0.0
     assert 100 * e["jenike_by_beta"]["theta_plus_omega"] == pytest.approx(50.4, abs=0.05)
@@ -105,7 +105,7 @@ def test_reference_numbers_i5_mclean_jenike():
 
 
 def test_reference_numbers_i2_eckhoff_leversen_c0_reading():
-    # hopper_theory.md §i.2: the "as documented" recipe
+    # docs/theory/hopper_theory.md §i.2: the "as documented" recipe
     pol = {H: critical_width_estimates(case("polymer").hopper(H), case("polymer").material("c0"))
            for H in (0.5, 1.0, 2.0)}
     sic = {H: critical_width_estimates(case("sic").hopper(H), case("sic").material("c0"))

@@ -1,5 +1,5 @@
 """Enstad's theory (bulkflow.theory.enstad): coefficients, eqs. 6.6-6.8, arch geometry and the
-reference numbers of /work/shared/reference/hopper_theory.md §d.8 and §i.5."""
+reference numbers of docs/theory/hopper_theory.md §d.8 and §i.5."""
 import math
 
 import numpy as np
@@ -21,7 +21,7 @@ def _params(key):
 
 
 def test_X_is_about_7_for_case_A_and_1_for_case_B():
-    # thesis §6.5.1: "X ≈ 7 for Case A and X ≈ 1 for Case B"; hopper_theory.md: 7.04 and 1.04
+    # thesis §6.5.1: "X ≈ 7 for Case A and X ≈ 1 for Case B"; docs/theory/hopper_theory.md: 7.04 and 1.04
     for key, ref in (("A", 7.04), ("B", 1.04)):
         c, m, d, ba, bc = _params(key)
         assert E.X_factor(d, c.theta_deg, bc) == pytest.approx(ref, abs=0.005)
@@ -117,7 +117,7 @@ def test_enstad_beta_readings():
         assert E.enstad_beta(30, 20, 0.0, reading) == (0.0, 0.0)
 
 
-# hopper_theory.md §i.5 (eq. 6.9, δ_mod, first radial term, Enstad β = min(ω, 45° − θ/2)), cm
+# docs/theory/hopper_theory.md §i.5 (eq. 6.9, δ_mod, first radial term, Enstad β = min(ω, 45° − θ/2)), cm
 I5 = {"A": [48.6, 51.3, 52.0, 52.2, 52.3, 52.3, 52.3], "B": [53.6, 37.9, 31.2, 24.8, 21.7, 19.7, 18.4]}
 I5_H = [0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0]
 
@@ -147,7 +147,7 @@ def test_critical_radius_is_the_first_zero_of_sigma2():
 
 
 def test_no_flow_when_the_arch_is_stable_everywhere():
-    # polymer, reading c0, H = 0.5 m: stable at every outlet below the surface (hopper_theory §i.2)
+    # polymer, reading c0, H = 0.5 m: stable at every outlet below the surface (docs/theory/hopper_theory.md §i.2)
     c = case("polymer")
     est = critical_width_estimates(c.hopper(0.5), c.material("c0"))
     assert math.isinf(est["enstad"])

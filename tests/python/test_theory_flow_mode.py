@@ -1,4 +1,4 @@
-"""Mass/funnel-flow boundary (hopper_theory.md §h) and the radial stress field behind it."""
+"""Mass/funnel-flow boundary (docs/theory/hopper_theory.md §h) and the radial stress field behind it."""
 import math
 
 import pytest

@@ -39,7 +39,7 @@ def test_delta_mod_k_zero_is_phi_and_values():
 @pytest.mark.parametrize("phi,k,fc0", [(40, 0.2, 1500.0), (34, 0.62, 519.0), (28.6, 0.47, 589.0)])
 def test_delta_mod_is_the_constant_angle_of_the_steady_flow_circles(phi, k, fc0):
     # circle (p, q) tangent to the IYL whose f_c = f_c0 + k σ₁ with σ₁ = p + q:
-    # q = p sin φ + c cos φ, c cos φ = f_c (1 − sin φ)/2. hopper_theory §c.1: q = sin δ_mod (p + p₀)
+    # q = p sin φ + c cos φ, c cos φ = f_c (1 − sin φ)/2. docs/theory/hopper_theory.md §c.1: q = sin δ_mod (p + p₀)
     s = math.sin(math.radians(phi))
     sd = sin_delta_mod(phi, k)
     p0 = fc0 * (1 - s) / (2 * s + k * (1 - s))

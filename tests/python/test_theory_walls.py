@@ -1,5 +1,5 @@
 """Wall stresses: Walker's D and its bin limit, Walters' bin factor, the slice solution, the
-discharge switch, Enstad-arc wall stresses and Janssen (hopper_theory.md §e, §f)."""
+discharge switch, Enstad-arc wall stresses and Janssen (docs/theory/hopper_theory.md §e, §f)."""
 import math
 
 import numpy as np
@@ -48,7 +48,7 @@ def test_slice_solution_satisfies_the_slice_balance(state):
 
 
 def test_table_4_2_wall_stresses():
-    # hopper_theory.md §e.4: θ = 30°, φ_w = 5°, φ = δ = 20°, ρ = 1600, surface 3 m above the apex
+    # docs/theory/hopper_theory.md §e.4: θ = 30°, φ_w = 5°, φ = δ = 20°, ρ = 1600, surface 3 m above the apex
     y = np.array([0.5, 1.0, 2.0])
     walker = W.wall_normal_stress(y, 3.0, 1600.0, 20.0, 5.0, 30.0, "passive") / 1e3
     assert np.allclose(walker, [28.3, 30.1, 19.4], atol=0.05)

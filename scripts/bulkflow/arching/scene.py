@@ -8,7 +8,7 @@ top surface y = H (H: vertical height of the top above the apex, the theory pack
 `Hopper.height`). The outlet arc meets the wall at the distance r_out = B / (2 sin θ) from the
 apex (B: outlet width); it is centred at the apex (`arch="apex"`, the thesis FEM) or on the axis
 at r_out sin β / sin(θ + β) above it, with radius r_out sin θ / sin(θ + β) (`arch="enstad"`,
-Enstad's arch meeting the wall at β to its normal; hopper_theory.md §d.1).
+Enstad's arch meeting the wall at β to its normal; docs/theory/hopper_theory.md §d.1).
 
 Mesh: a polar mesh of CPE4R elements — `n_arc` elements along the outlet (rays from the apex at
 equal angles) and rows spaced geometrically along each ray so that elements stay close to square
@@ -58,7 +58,7 @@ def fc0_from_c0(c0: float, phi_deg: float) -> float:
 
 #: The named cases are the theory package's (thesis Tables 6.1, 6.2: bulkflow.theory.cases), so
 #: scenes and estimates share one source. How the tabulated cohesion becomes fc0 (issue 4 part 3,
-#: hopper_theory.md §0.4): "c0" — it is c0 and eq. 6.9 gives fc0 (as the thesis documents); "fc0" —
+#: docs/theory/hopper_theory.md §0 item 4): "c0" — it is c0 and eq. 6.9 gives fc0 (as the thesis documents); "fc0" —
 #: it is fc0 itself (what the thesis's own polymer theory numbers imply). Cases A and B offer "c0"
 #: only. The powders' fill height is not reported; the theory's EL_HEIGHT (1 m above the apex).
 CASE_NAMES = tuple(CASES)

@@ -13,7 +13,7 @@ is located by linear interpolation of MFI between them. If a series does not cro
 extended (up to `--extend` points, by its last step, within physical limits) in the direction in
 which the MFI moves towards 0.3 -- the choice of ranges is thus checked by the data, not tuned.
 
-Why these ranges (theory/flow_mode.py, hopper_theory.md §h): for delta = phi = 25 deg the conical
+Why these ranges (theory/flow_mode.py, docs/theory/hopper_theory.md §h): for delta = phi = 25 deg the conical
 mass-flow limit is theta_c = 40 deg at phi_w = 15 deg (58 deg at 5, 29.5 deg at 20); the plane
 (wedge) limit is larger (rule of thumb +10 deg). Jenike's plane-flow chart (thesis Fig. 4.16) is
 not available (no closed form, no digitised data), so the theta-phi_w plot carries the conical

@@ -22,7 +22,7 @@ The within-one-cell band is reduced and reported too ("cut cell").
 
 Theory ("modified Walker", thesis §4.5.4). The thesis means Walker's method of differential
 slices with Walters' distribution factor (thesis §1.2, its ref. 18). Walters' factor for HOPPERS
-is not available to the project (hopper_theory.md §e.3; theory/walker.py implements only the
+is not available to the project (docs/theory/hopper_theory.md §e.3; theory/walker.py implements only the
 bin form), so the curves here are Walker's slice solution with Walker's own distribution factor
 D (wall at yield, theory/walker.py wall_normal_stress):
   filling:     active state everywhere (omega_a), free surface at the fill top, no surcharge;

@@ -9,7 +9,7 @@ Sources: thesis eqs. 1.4–1.7 (Beverloo et al. 1961; Nedderman 1992 for k = 1.5
     ṁ_RT = ṁ_B F,   F = (tan θ)^{-0.35}  (thesis form)                  (1.7)
 
 Assumptions: cohesionless, free-flowing material; C is not given by the thesis (0.55–0.65 is the
-usual range; default 0.58, hopper_theory.md §a, from memory). General Rose–Tanaka form
+usual range; default 0.58, docs/theory/hopper_theory.md §a). General Rose–Tanaka form
 (Nedderman 1992 ch. 10, from memory): F = (tan θ tan φ_d)^{-0.35} for θ < 90° − φ_d, 1 otherwise,
 φ_d = angle of the stagnant-zone boundary with the horizontal; the thesis form is φ_d = 45°.
 The steep-wall limit (θ ≥ 90° − φ_d, flat-bottomed bin behaviour) gives F = 1.

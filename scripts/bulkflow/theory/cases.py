@@ -6,14 +6,14 @@ stress (c0) is reported in Table 6.1" next to eq. 6.9). Case A: a pharmaceutical
 a hypothetical clay-like material on frictionless walls.
 
 Eckhoff & Leversen powders (Table 6.2): polymer and SiC. The table labels 519 Pa and 175 Pa
-"Cohesion at zero consolidation stress, c0", but hopper_theory.md §0.3/§i shows that the thesis's
+"Cohesion at zero consolidation stress, c0", but docs/theory/hopper_theory.md §0 item 3, §i shows that the thesis's
 own Table 6.3 theory values cannot follow from that with eq. 6.9 (the polymer's McLean 35 cm
 needs f_c ≈ 1410 Pa at the arch, below the eq. 6.9 value f_c0 = 1952 Pa). This is an OPEN
 QUESTION, so both readings are provided, named:
 
   reading "c0"  : the tabulated value is c0; f_c0 = 2 c0 cos φ/(1 − sin φ) (eq. 6.9), as documented;
   reading "fc0" : the tabulated value is f_c0 itself (no eq. 6.9); the reading that fits the
-                  polymer row (to ~2 % with other choices, hopper_theory.md §i.3), not the SiC row.
+                  polymer row (to ~2 % with other choices, docs/theory/hopper_theory.md §i.3), not the SiC row.
 
 Elastic constants (E = 10 MPa, ν = 0.2) are the thesis's arbitrary choice (Table 6.2 footnote).
 The fill heights of the experiments are unknown; EL_HEIGHT (1 m above the apex) is our default

@@ -233,7 +233,7 @@ def print_table_6_3(rows, readings, out=None):
         w(f"  {r['powder']:8s} {'reading ' + r['reading']:14s} {r['fc0']:9.1f} {_cm(r['mclean']):>8s} "
           f"{_cm(r['jenike']):>8s} {_cm(r['enstad']):>8s} {_cm(r['jenike_beta_omega']):>12s}\n")
     w("\n  The thesis row values cannot be reproduced with one consistent reading "
-      "(hopper_theory.md section i): the 'c0' reading is what the thesis documents;\n"
+      "(docs/theory/hopper_theory.md section i): the 'c0' reading is what the thesis documents;\n"
       "  the 'fc0' reading comes closer for the polymer but far below for SiC.\n")
 
 

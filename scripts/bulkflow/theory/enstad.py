@@ -16,12 +16,12 @@ at the angle β to the wall normal and is centred on the hopper axis (not at the
   iterative procedure ... to find r_outlet such that the minor stress at the outlet is zero").
 
 The coefficients X, Y, X_b, Y_b, Z_b, Z_0, a, b, c, d are not printed in the thesis; they are
-re-derived for plane flow (m = 0) in /work/shared/reference/hopper_theory.md §d.1–d.5 (the plane
+re-derived for plane flow (m = 0) in docs/theory/hopper_theory.md §d.1–d.5 (the plane
 form of Arnold & McLean's coefficients) and re-derived again for this module from the slice
 balance (§d.2): r σ₂' = −σ₂ − ρgWr + [σ₁ cos β sin α − σ₂ sin β cos α]/sin θ, α = θ + β.
 
 Which β (thesis: "depends on φ_w and θ"; "the arch gets the maximum lift from the walls"):
-see :func:`enstad_beta`; default ``omega_cap`` = min(ω_p(δ_mod), 45° − θ/2) (hopper_theory.md §d.6).
+see :func:`enstad_beta`; default ``omega_cap`` = min(ω_p(δ_mod), 45° − θ/2) (docs/theory/hopper_theory.md §d.6).
 
 Degenerate exponents (X = 1, X_b = 1, X = X_b) are handled by nudging the exponent by 1e-6
 (the solution is continuous in them); the numerical integrator :func:`sigma2_bar_numeric` is the
@@ -45,7 +45,7 @@ __all__ = [
     "critical_radius", "critical_width", "sigma2_bar_numeric",
 ]
 
-G_STANDARD = 9.81   #: gravity used throughout (thesis; hopper_theory.md conventions)
+G_STANDARD = 9.81   #: gravity used throughout (thesis; docs/theory/hopper_theory.md conventions)
 _EPS_EXP = 1e-6
 
 
@@ -55,7 +55,7 @@ def _rad(a):
 
 # ---- β ----------------------------------------------------------------------------------------
 def enstad_beta(theta_deg: float, delta_deg: float, phi_w_deg: float, reading: str = "omega_cap"):
-    """(β_arch, β_cons) in degrees for Enstad's arcs (hopper_theory.md §d.6).
+    """(β_arch, β_cons) in degrees for Enstad's arcs (docs/theory/hopper_theory.md §d.6).
 
     readings
       ``omega``      β = ω_p(δ) for both the arch and the consolidation field;
@@ -78,7 +78,7 @@ def enstad_beta(theta_deg: float, delta_deg: float, phi_w_deg: float, reading: s
     raise ValueError(f"unknown Enstad beta reading {reading!r} (omega, omega_cap, phiw_cap)")
 
 
-# ---- arc geometry (hopper_theory.md §d.1) ----------------------------------------------------
+# ---- arc geometry (docs/theory/hopper_theory.md §d.1) ----------------------------------------------------
 def arch_alpha_deg(theta_deg, beta_deg):
     """α = θ + β: rise of the arc tangent above the horizontal at the wall; the arc subtends 2α."""
     return theta_deg + beta_deg
@@ -119,7 +119,7 @@ def W_factor(theta_deg, beta_deg):
     """W(θ, β) = [α sin θ + sin β sin α]/sin²α (α = θ + β in radians in the first term).
 
     The area between the apex and the arc through the wall points at r is r² sin θ · W
-    (hopper_theory.md §d.1); it enters the weight term of the slice balance.
+    (docs/theory/hopper_theory.md §d.1); it enters the weight term of the slice balance.
     """
     a = _rad(theta_deg + beta_deg)
     t = _rad(theta_deg)
@@ -128,7 +128,7 @@ def W_factor(theta_deg, beta_deg):
 
 
 def X_factor(angle_deg, theta_deg, beta_deg):
-    """X = [sin δ/(1 − sin δ)] · [sin(2β + θ)/sin θ + 1] (hopper_theory.md §d.3; thesis eq. 6.8).
+    """X = [sin δ/(1 − sin δ)] · [sin(2β + θ)/sin θ + 1] (docs/theory/hopper_theory.md §d.3; thesis eq. 6.8).
 
     With δ = δ_mod this is eq. 6.8's exponent; with the internal friction angle φ it is X_b of
     eq. 6.6. Thesis §6.5.1: X ≈ 7 for Case A, X ≈ 1 for Case B.
@@ -138,7 +138,7 @@ def X_factor(angle_deg, theta_deg, beta_deg):
 
 
 def Y_factor(delta_deg, theta_deg, beta_deg, quantity: str = "sigma1"):
-    """Y of eq. 6.8 for the stress the equation is written in (hopper_theory.md §d.3 trap).
+    """Y of eq. 6.8 for the stress the equation is written in (docs/theory/hopper_theory.md §d.3 trap).
 
     ``sigma1``: Y = K_δ W (default; what the flow function f_c(σ₁) needs);
     ``mean``  : Y = W/(1 − sin δ) (Arnold & McLean's Y, σ = mean stress);
@@ -238,7 +238,7 @@ class ArchingSolution:
 
 def arching_solution(theta_deg, phi_deg, delta_deg, beta_arch_deg, beta_cons_deg, k, fc0, rho, R,
                      sigma2_R=0.0, sigma1_cons_R=0.0, g=G_STANDARD) -> ArchingSolution:
-    """Coefficients of eqs. 6.6/6.7 (hopper_theory.md §d.4, re-derived).
+    """Coefficients of eqs. 6.6/6.7 (docs/theory/hopper_theory.md §d.4, re-derived).
 
     X_b = X(φ, θ, β_arch); W, G with β_arch; X, Y (σ₁ version) of the consolidation field with
     δ and β_cons; Y_b = W − kGY/(X − 1); Z_b = kG(σ₁,R − ρgYR/(X − 1)); Z_0 = G f_c0;
@@ -264,7 +264,7 @@ def arching_solution(theta_deg, phi_deg, delta_deg, beta_arch_deg, beta_cons_deg
 
 
 def critical_radius(sol, n_grid: int = 4000) -> float:
-    """r*: the first root of σ̄₂(r) = 0 on (0, R) (hopper_theory.md §d.5).
+    """r*: the first root of σ̄₂(r) = 0 on (0, R) (docs/theory/hopper_theory.md §d.5).
 
     Outlets at wall distance r_o < r* arch (no flow). Returns inf if σ̄₂ < 0 on all of (0, R)
     (an arch is stable at any outlet below the surface), 0 if σ̄₂(0+) ≥ 0 (no cohesion).

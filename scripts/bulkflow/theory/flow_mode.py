@@ -1,4 +1,4 @@
-"""Mass-flow / funnel-flow boundary (hopper_theory.md §h; thesis §4.5.7, Fig. 4.16).
+"""Mass-flow / funnel-flow boundary (docs/theory/hopper_theory.md §h; thesis §4.5.7, Fig. 4.16).
 
 What is implemented, and how far it can be trusted:
 

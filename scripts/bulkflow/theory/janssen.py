@@ -1,4 +1,4 @@
-"""Janssen's stresses in a plane bin (two parallel vertical walls), hopper_theory.md §f.
+"""Janssen's stresses in a plane bin (two parallel vertical walls), docs/theory/hopper_theory.md §f.
 
     σ̄_v(z) = (ρ g b/(K μ_w)) [1 − exp(−K μ_w z/b)] + Q exp(−K μ_w z/b),  σ_w = K σ̄_v,  μ_w = tan φ_w
 

@@ -8,9 +8,9 @@ vicinity of the outlet at the passive consolidation stress; the stresses from th
 a thin layer near the outlet are neglected, so B does not depend on the fill height.
 
 Eq. 6.3 is the θ → 0 limit of a thin circular arch of uniform vertical thickness
-(:func:`thin_arch_stress_theta`, hopper_theory.md §c.2); it is *not* Jenike's H(θ) chart.
+(:func:`thin_arch_stress_theta`, docs/theory/hopper_theory.md §c.2); it is *not* Jenike's H(θ) chart.
 
-Which β (hopper_theory.md §c.2; the thesis never states which one it used):
+Which β (docs/theory/hopper_theory.md §c.2; the thesis never states which one it used):
   ``theta_plus_omega`` (default) β = θ + ω_p(δ_mod), the angle of σ₁ from the horizontal at the
       wall. It is the only reading that matches the thesis's verbal statements for Case B
       (φ_w = 0: "Jenike predicts flow at 60 cm and no flow at 30 cm"): 50.4 cm;
@@ -23,7 +23,7 @@ Consolidation near the outlet (σ₁ = S ρ g B):
   for Jenike and McLean (§6.5.3: "Instead of using the radial stress theory ... the first radial
   term of Eq. (6.8) was used"); :func:`radial_stress_field` — Jenike's radial stress field.
 
-With a linear flow function the critical width has a closed form (hopper_theory.md §c.3):
+With a linear flow function the critical width has a closed form (docs/theory/hopper_theory.md §c.3):
 B = H f_c0/(ρ g (1 − k S H)), H = sin 2β for eq. 6.4 and 1 + 0.005θ for McLean.
 """
 from __future__ import annotations
@@ -77,7 +77,7 @@ def thin_arch_stress(B: float, rho: float, beta_deg: float, g: float = G_STANDAR
 
 def thin_arch_stress_theta(B: float, rho: float, theta_deg: float, beta_deg: float,
                            g: float = G_STANDARD) -> float:
-    """Thin circular arch keeping θ (hopper_theory.md §c.2, thin-layer limit of Enstad's ODE):
+    """Thin circular arch keeping θ (docs/theory/hopper_theory.md §c.2, thin-layer limit of Enstad's ODE):
     σ̄₁ = ρ g (B/2)[α sin θ + sin β sin α]/(cos β sin³α), α = θ + β (radians in the first α).
     θ → 0 recovers eq. 6.3."""
     t, b = math.radians(theta_deg), math.radians(beta_deg)
@@ -123,7 +123,7 @@ def critical_width_general(flow_function, rho: float, H: float, sigma1_outlet, g
 
 def S_first_term(theta_deg: float, delta_deg: float, beta_deg: float, quantity: str = "sigma1") -> float:
     """S = σ₁/(ρ g B) at the outlet wall from the first radial term of eq. 6.8 at r = B/(2 sin θ):
-    S = Y/((X − 1) 2 sin θ) with X, Y of Enstad's arcs at angle β (hopper_theory.md §c.4 route 2).
+    S = Y/((X − 1) 2 sin θ) with X, Y of Enstad's arcs at angle β (docs/theory/hopper_theory.md §c.4 route 2).
     inf for X ≤ 1 (first term meaningless: e.g. Case B)."""
     X = float(enstad.X_factor(delta_deg, theta_deg, beta_deg))
     if X <= 1.0:
@@ -190,7 +190,7 @@ def _shoot(geometry, S, s0, theta_rad, dense=False):
 
 def radial_stress_field(delta_deg: float, phi_w_deg: float, theta_deg: float,
                         geometry: str = "plane", s0_range=(1e-3, 50.0)) -> RadialField:
-    """Jenike's passive radial stress field by shooting on s(0) (hopper_theory.md §c.4 route 1).
+    """Jenike's passive radial stress field by shooting on s(0) (docs/theory/hopper_theory.md §c.4 route 1).
 
     Equilibrium in polar coordinates with p = ρ g r s(t), σ₁,₂ = p(1 ± sin δ) (Coulomb material
     at yield with δ), symmetry ψ(0) = 90° and the wall condition ψ(θ) = 90° + ω_p. The conical

@@ -7,7 +7,7 @@ the point sink (the thesis does not say whether up or down; here y > 0 is the he
 sink), D: the diffusion length (a few particle diameters; it grows with height in the thesis FEM
 and in experiments). The plane point-sink solution is the heat kernel
 v = Q/√(4π D y) exp(−x²/(4 D y)) with Q the volumetric flow per unit length
-(hopper_theory.md §g, derived): its integral over x is Q at every height (the flux is conserved).
+(docs/theory/hopper_theory.md §g, derived): its integral over x is Q at every height (the flux is conserved).
 Sign: the magnitude of the downward velocity is returned (positive).
 """
 from __future__ import annotations

@@ -6,7 +6,7 @@ Source: thesis eq. 1.8 = eq. 6.5 (McLean, based on Jenike's work):
 
 f_c is the unconfined yield strength at the consolidation stress near the outlet and ρ the bulk
 density at the outlet. It is Jenike's form B = H(θ) f_c/(ρg) with H(θ) = 1 + θ/200
-(hopper_theory.md §b, §c.3). The thesis notes it has been shown to be over-conservative.
+(docs/theory/hopper_theory.md §b, §c.3). The thesis notes it has been shown to be over-conservative.
 How f_c is found (which consolidation stress) is the same question as for Jenike;
 :func:`critical_width_linear` uses σ₁ = S ρ g B (S from :mod:`bulkflow.theory.jenike`).
 """

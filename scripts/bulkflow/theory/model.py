@@ -10,7 +10,7 @@ These names are a stable interface (other code brackets its searches with them);
 added to the result, existing ones keep their meaning.
 
 Geometry: `Hopper.height` is the vertical height of the horizontal free surface above the hopper
-APEX (the virtual apex of the wedge), so R = H/cos θ along the wall (hopper_theory.md §d.3).
+APEX (the virtual apex of the wedge), so R = H/cos θ along the wall (docs/theory/hopper_theory.md §d.3).
 (The scene generator bulkflow.scenes.wedge_hopper measures its `height` above the outlet instead.)
 """
 from __future__ import annotations
@@ -169,7 +169,7 @@ def critical_width_estimates(hopper: Hopper, material: Material, *,
       every β reading), 'notes' (list of warnings), and if the hopper has an outlet width: 'outlet_width' and 'flows'
       ({theory: outlet_width > B_crit}).
 
-    Readings (hopper_theory.md §c.2, §c.4, §d.6; defaults in :data:`DEFAULT_READINGS`):
+    Readings (docs/theory/hopper_theory.md §c.2, §c.4, §d.6; defaults in :data:`DEFAULT_READINGS`):
       jenike_beta   see :data:`bulkflow.theory.jenike.JENIKE_BETA_READINGS` (default θ + ω_p,
                     the one that matches the thesis's Case B statements);
       enstad_beta   omega | omega_cap (default) | phiw_cap;

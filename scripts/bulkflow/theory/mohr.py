@@ -9,7 +9,7 @@ Sources
   (unconfined yield strength from the cohesion of the incipient yield locus).
 * The wall angle ω from Coulomb wall friction on a Mohr circle of angle δ:
   sin φ_w = sin δ sin(2ω − φ_w) (Nedderman 1992 ch. 4; re-derived in
-  /work/shared/reference/hopper_theory.md §c.2).
+  docs/theory/hopper_theory.md §c.2).
 """
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ def sin_delta_mod(phi_deg: float, k: float) -> float:
     Assumptions: constant φ and a linear flow function f_c = f_c0 + k σ₁ (eq. 6.1). The modified
     EYL is the line of constant slope sin δ_mod tangent to the steady-flow Mohr circles, offset
     from the origin by p₀ = f_c0 (1 − sin φ)/(2 sin φ + k (1 − sin φ)) along the σ axis
-    (hopper_theory.md §c.1; the offset is neglected in the theories, as in the thesis).
+    (docs/theory/hopper_theory.md §c.1; the offset is neglected in the theories, as in the thesis).
     k = 0 gives δ_mod = φ. Raises ValueError when sin δ_mod ≥ 1 (k too large for φ).
     """
     s = math.sin(_rad(phi_deg))
@@ -79,7 +79,7 @@ def _asin_ratio(phi_w_deg: float, delta_deg: float) -> float:
 def wall_angle_passive_deg(delta_deg: float, phi_w_deg: float) -> float:
     """ω_p: angle between σ₁ and the wall normal in the passive (discharge) state.
 
-    ω_p = ½ [φ_w + asin(sin φ_w / sin δ)]  (hopper_theory.md §c.2, Nedderman 1992 ch. 4).
+    ω_p = ½ [φ_w + asin(sin φ_w / sin δ)]  (docs/theory/hopper_theory.md §c.2, Nedderman 1992 ch. 4).
     σ₁ at the right-hand wall is tilted upward from the inward wall normal by ω_p, so it makes
     the angle θ + ω_p with the horizontal. φ_w = 0 gives 0 (σ₁ normal to a smooth wall).
     If sin φ_w > sin δ the asin is capped at 90° (fully rough wall).
@@ -90,6 +90,6 @@ def wall_angle_passive_deg(delta_deg: float, phi_w_deg: float) -> float:
 def wall_angle_active_deg(delta_deg: float, phi_w_deg: float) -> float:
     """ω_a: the same angle in the active (filling) state, σ₁ roughly vertical.
 
-    ω_a = ½ [φ_w + 180° − asin(sin φ_w / sin δ)]  (hopper_theory.md §c.2). φ_w = 0 gives 90°.
+    ω_a = ½ [φ_w + 180° − asin(sin φ_w / sin δ)]  (docs/theory/hopper_theory.md §c.2). φ_w = 0 gives 90°.
     """
     return 0.5 * (phi_w_deg + 180.0 - _asin_ratio(phi_w_deg, delta_deg))

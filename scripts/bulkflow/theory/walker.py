@@ -3,7 +3,7 @@ or Walters' distribution factor, for filling (active) and discharge (passive, wi
 and the passive wall stress on Enstad's arcs.
 
 Sources (thesis §1.2.2, §4.5.4 "modified Walker's theory" [its ref. 18: Walters]; formulas
-re-derived in /work/shared/reference/hopper_theory.md §e, the slice balance as in Tardos 1999):
+re-derived in docs/theory/hopper_theory.md §e, the slice balance as in Tardos 1999):
 
     y dσ̄_v/dy + σ̄_v = −ρ g y + σ_w + τ_w cot θ ... → (wedge, m = 0; cone m = 1)
     σ̄_v(y) = ρgy/(N − 1) [1 − (y/H_t)^{N−1}] + Q (y/H_t)^N,  σ_w = D σ̄_v, τ_w = σ_w tan φ_w
@@ -16,7 +16,7 @@ Q) above the apex. Walker's D takes σ̄_v equal to σ_v at the wall, the wall a
 Walters' factor: only the bin (vertical wall) form is implemented, numerically, from its
 assumptions (τ_xy linear from axis to wall, σ_xx uniform, yield with δ across the slice;
 Walters 1973, not re-read): :func:`walters_D_bin`. Walters' closed form for HOPPERS was not
-available (hopper_theory.md §e.3); the wedge functions here use Walker's D and say so, and
+available (docs/theory/hopper_theory.md §e.3); the wedge functions here use Walker's D and say so, and
 :func:`enstad_wall_stress` is the self-consistent passive alternative.
 Cohesionless (δ = φ) unless the caller passes δ_mod.
 """
@@ -34,7 +34,7 @@ __all__ = ["walker_D", "walker_K_bin", "walters_D_bin", "slice_exponent", "slice
 
 
 def walker_D(delta_deg, phi_w_deg, theta_deg, state="passive"):
-    """Walker's distribution factor D = σ_w/σ̄_v for a wall at yield (hopper_theory.md §e.2).
+    """Walker's distribution factor D = σ_w/σ̄_v for a wall at yield (docs/theory/hopper_theory.md §e.2).
 
     state "active" (filling, σ₁ about vertical) uses ω_a; "passive" (discharge) uses ω_p.
     θ = 0 reduces to Walker's bin K (:func:`walker_K_bin`).
@@ -66,7 +66,7 @@ def walters_D_bin(delta_deg, phi_w_deg, state="active", n=2001):
     minor (passive) normal stress of the yield circle through (σ_xx, τ_xy). The wall stress σ_w
     and τ_w = σ_w tan φ_w fix the wall point, whose circle must also satisfy Walker's wall K.
     Numerical (trapezoid over n points). Example δ = 35°, φ_w = 20°: 0.277 active, 2.845 passive
-    (hopper_theory.md §e.3)."""
+    (docs/theory/hopper_theory.md §e.3)."""
     S = math.sin(math.radians(delta_deg))
     K = walker_K_bin(delta_deg, phi_w_deg, state)     # σ_w/σ_yy at the wall
     # at the wall: σ_xx = σ_w = 1, τ_w = tan φ_w; σ_yy(wall) = 1/K
@@ -117,7 +117,7 @@ def wall_normal_stress(y, H_t, rho, delta_deg, phi_w_deg, theta_deg, state="pass
 
 def wall_normal_stress_switch(y, H_t, y_switch, rho, delta_deg, phi_w_deg, theta_deg, Q=0.0,
                               geometry="wedge", g=G_STANDARD):
-    """Discharge with a switch (hopper_theory.md §e.2): active field above y_switch (from the
+    """Discharge with a switch (docs/theory/hopper_theory.md §e.2): active field above y_switch (from the
     surface H_t with surcharge Q), passive field below it, loaded by the active σ̄_v at the
     switch; σ_w jumps from D_a σ̄_v to D_p σ̄_v there (the peak seen in thesis Fig. 4.12/4.17)."""
     y = np.asarray(y, dtype=float)
@@ -132,7 +132,7 @@ def wall_normal_stress_switch(y, H_t, y_switch, rho, delta_deg, phi_w_deg, theta
 
 
 def enstad_wall_stress(r, R, rho, theta_deg, delta_deg, beta_deg, g=G_STANDARD):
-    """Passive wall normal stress on Enstad's arcs (hopper_theory.md §e.4, free surface):
+    """Passive wall normal stress on Enstad's arcs (docs/theory/hopper_theory.md §e.4, free surface):
     σ_w(r) = σ₂(r)[K_δ cos²β + sin²β], σ₂(r) = ρgWr/(X − 1)[1 − (r/R)^{X−1}], r along the wall."""
     r = np.asarray(r, dtype=float)
     X = float(X_factor(delta_deg, theta_deg, beta_deg))
