@@ -20,7 +20,7 @@ module error_report
 
   public :: error_t
   public :: set_error, raise_error, fatal_error, report_and_stop
-  public :: format_error_location, add_expectation
+  public :: format_error_location, add_expectation, pass_error
   public :: final_stop_i, set_final_stop, reset_final_stop
 
   !> One recorded error. `message` holds the full "file:line: text" form
@@ -89,6 +89,19 @@ contains
 
   !> Append "; expected <what>" to a raised error unless its message says what was expected
   !> already (the rule for every message: what is wrong and what was expected).
+  !> Hand an error recorded in `local` to the caller's `err`, or stop with it when the caller
+  !> gave none (the convention of the routines with an optional error argument).
+  subroutine pass_error(local, err)
+    type(error_t), intent(in) :: local
+    type(error_t), intent(inout), optional :: err
+
+    if (present(err)) then
+       err = local
+    else
+       call raise_error('', 0, local%message)
+    end if
+  end subroutine pass_error
+
   subroutine add_expectation(err, what)
     type(error_t), intent(inout) :: err
     character(len=*), intent(in) :: what
