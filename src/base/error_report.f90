@@ -12,7 +12,8 @@
 !>
 !> The final stop is a procedure pointer so that the MPI solver can route it to
 !> MPI_Abort (a plain `error stop` on one rank would leave the others hanging).
-!> The default is `error stop 2`: no backtrace, a non-zero exit status.
+!> The default is `error stop 2` (quiet: the message is said; the runtime's "ERROR STOP 2" and its
+!> note on signalling floating-point flags would only add noise): a non-zero exit status.
 module error_report
   use, intrinsic :: iso_fortran_env, only: error_unit
   implicit none
@@ -149,11 +150,11 @@ contains
     flush (error_unit)
     call final_stop()
     ! A final-stop procedure must not return; make sure nothing runs on.
-    error stop 2
+    error stop 2, quiet=.true.
   end subroutine print_and_stop
 
   subroutine default_final_stop()
-    error stop 2
+    error stop 2, quiet=.true.
   end subroutine default_final_stop
 
 end module error_report

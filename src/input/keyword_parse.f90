@@ -228,7 +228,8 @@ contains
             '" (looked for ' // resolved // ')', err)
        return
     else if (len(problem) > 0) then
-       call raise_error(src%name, line, '*INCLUDE: ' // problem // '; expected INPUT= to name a file', err)
+       call raise_error(src%name, line, '*INCLUDE, INPUT=' // incfile // ': ' // problem // &
+            '; expected INPUT= to name a file', err)
        return
     end if
     call parse_source(inc, deck, depth + 1, err)

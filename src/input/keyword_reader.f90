@@ -33,7 +33,7 @@ module keyword_reader
 
   public :: keyword_param_t, data_line_t, keyword_block_t, keyword_deck_t
   public :: read_keyword_file, read_keyword_string
-  public :: upper_case, is_real_text, is_integer_text
+  public :: upper_case, is_real_text, is_integer_text, is_integer_syntax
 
   !> Deepest *INCLUDE nesting accepted; deeper means a circular include.
   integer, parameter :: max_include_depth = 32
