@@ -404,53 +404,36 @@ contains
     p%value = piece(i1:i2)
   end subroutine parse_parameter
 
-  !> The first parameter (in order) whose name an earlier one has, 0 if none. Names sorted
-  !> (stable merge sort), so a keyword line of many parameters costs n log n, not n².
+  !> The first parameter (in order) whose name an earlier one has, 0 if none. The names go
+  !> into an open-addressing hash table as they come, so a keyword line of many parameters
+  !> costs n, not n² comparisons.
   pure integer function first_repeated(params) result(dup)
     type(keyword_param_t), intent(in) :: params(:)
-    integer, allocatable :: perm(:), work(:)
-    integer :: n, width, lo, mid, hi, i, j, k
+    integer, allocatable :: table(:)
+    integer :: size_table, k, slot, c
+    integer(int64) :: h
 
-    n = size(params)
     dup = 0
-    allocate (perm(n), work(n))
-    perm = [(i, i = 1, n)]
-    width = 1
-    do while (width < n)
-       lo = 1
-       do while (lo <= n)
-          mid = min(lo + width - 1, n)
-          hi = min(lo + 2 * width - 1, n)
-          i = lo
-          j = mid + 1
-          do k = lo, hi
-             if (j > hi) then
-                work(k) = perm(i)
-                i = i + 1
-             else if (i > mid) then
-                work(k) = perm(j)
-                j = j + 1
-             else if (llt(params(perm(j))%name, params(perm(i))%name)) then
-                work(k) = perm(j)
-                j = j + 1
-             else
-                work(k) = perm(i)
-                i = i + 1
-             end if
-          end do
-          lo = lo + 2 * width
-       end do
-       perm = work
-       width = 2 * width
+    size_table = 16
+    do while (size_table < 2 * size(params))
+       size_table = 2 * size_table
     end do
-    ! within a run of equal names the order is the input order: its second is a repeat
-    do k = 2, n
-       if (params(perm(k))%name == params(perm(k - 1))%name) then
-          if (k > 2) then
-             if (params(perm(k - 2))%name == params(perm(k))%name) cycle
+    allocate (table(0:size_table - 1))
+    table = 0
+    do k = 1, size(params)
+       h = 5381
+       do c = 1, len(params(k)%name)
+          h = mod(33 * h + iachar(params(k)%name(c:c)), 2147483647_int64)
+       end do
+       slot = int(mod(h, int(size_table, int64)))
+       do while (table(slot) /= 0)
+          if (params(table(slot))%name == params(k)%name) then
+             dup = k
+             return
           end if
-          if (dup == 0 .or. perm(k) < dup) dup = perm(k)
-       end if
+          slot = mod(slot + 1, size_table)
+       end do
+       table(slot) = k
     end do
   end function first_repeated
 

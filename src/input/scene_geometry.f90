@@ -8,6 +8,7 @@
 !> check too. "Zero" is relative: |V| below 1e-12 of the cube (square) of the element's longest
 !> edge, well below any mesh a solver can integrate.
 module scene_geometry
+  use, intrinsic :: iso_fortran_env, only: int64
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t
@@ -40,6 +41,16 @@ contains
 
     nd = model%mesh%ndim
     ne = model%mesh%nen
+    ! The run's node-to-element lists hold n_elems × nen entries with 32-bit counts: a mesh
+    ! beyond them is refused here rather than overflowing there.
+    if (int(model%mesh%n_elems, int64) * ne > huge(1)) then
+       associate (blk => deck%blocks(sources%elem_block(1)))
+         call raise_error(blk%file, blk%line, 'the mesh has ' // itoa(model%mesh%n_elems) // ' elements of ' // &
+              itoa(ne) // ' nodes: more element-node entries than the 2147483647 a run indexes; expected ' // &
+              'a smaller mesh', err)
+       end associate
+       return
+    end if
     allocate (xe(chunk, nd, ne), volume(chunk), bmat(chunk, nd, ne), reason(chunk), size_of(chunk))
     do e0 = 1, model%mesh%n_elems, chunk
        nb = min(chunk, model%mesh%n_elems - e0 + 1)
