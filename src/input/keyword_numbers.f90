@@ -148,6 +148,12 @@ contains
     ok = is_real_text(text)
     if (.not. ok) return
     n = len_trim(text)
+    ! beyond the range of reals: refused before strtod, which would raise the overflow flag
+    ! (a trap in the debug build)
+    if (decimal_exponent(text(1:n)) > 308) then
+       ok = .false.
+       return
+    end if
     if (n < len(buf)) then
        buf(1:n) = text(1:n)
        do k = 1, n
@@ -183,6 +189,53 @@ contains
     end do
     name = t(1:n)
   end function normalize_name
+
+  !> The decimal exponent of the leading significant digit of a text of the strict real syntax
+  !> ("123.4e5" 7, "0.05" -2; 0 for a zero), the exponent clamped against integer overflow.
+  pure integer function decimal_exponent(text) result(e10)
+    character(len=*), intent(in) :: text
+    integer :: k, n, before, lead, expo, sgn
+    logical :: in_fraction, found
+
+    n = len(text)
+    k = 1
+    if (text(1:1) == '+' .or. text(1:1) == '-') k = 2
+    before = 0
+    lead = 0
+    in_fraction = .false.
+    found = .false.
+    do while (k <= n)
+       if (text(k:k) == '.') then
+          in_fraction = .true.
+       else if (is_digit(text(k:k))) then
+          if (text(k:k) /= '0') found = .true.
+          if (.not. in_fraction .and. found) before = before + 1
+          if (in_fraction .and. .not. found) lead = lead + 1
+       else
+          exit
+       end if
+       k = k + 1
+    end do
+    expo = 0
+    if (k < n) then
+       k = k + 1
+       sgn = 1
+       if (text(k:k) == '-') sgn = -1
+       if (text(k:k) == '+' .or. text(k:k) == '-') k = k + 1
+       do while (k <= n)
+          if (expo < 100000) expo = 10 * expo + (iachar(text(k:k)) - iachar('0'))
+          k = k + 1
+       end do
+       expo = sgn * expo
+    end if
+    if (.not. found) then
+       e10 = 0
+    else if (before > 0) then
+       e10 = before - 1 + expo
+    else
+       e10 = -(lead + 1) + expo
+    end if
+  end function decimal_exponent
 
   pure logical function is_digit(c)
     character, intent(in) :: c
