@@ -12,7 +12,8 @@
 !>
 !> The final stop is a procedure pointer so that the MPI solver can route it to
 !> MPI_Abort (a plain `error stop` on one rank would leave the others hanging).
-!> The default is `error stop 2`: no backtrace, a non-zero exit status.
+!> The default is `error stop 2` (quiet: the message is said; the runtime's "ERROR STOP 2" and its
+!> note on signalling floating-point flags would only add noise): a non-zero exit status.
 module error_report
   use, intrinsic :: iso_fortran_env, only: error_unit
   implicit none
@@ -20,7 +21,7 @@ module error_report
 
   public :: error_t
   public :: set_error, raise_error, fatal_error, report_and_stop
-  public :: format_error_location, add_expectation
+  public :: format_error_location, add_expectation, pass_error
   public :: final_stop_i, set_final_stop, reset_final_stop
 
   !> One recorded error. `message` holds the full "file:line: text" form
@@ -89,6 +90,19 @@ contains
 
   !> Append "; expected <what>" to a raised error unless its message says what was expected
   !> already (the rule for every message: what is wrong and what was expected).
+  !> Hand an error recorded in `local` to the caller's `err`, or stop with it when the caller
+  !> gave none (the convention of the routines with an optional error argument).
+  subroutine pass_error(local, err)
+    type(error_t), intent(in) :: local
+    type(error_t), intent(inout), optional :: err
+
+    if (present(err)) then
+       err = local
+    else
+       call raise_error('', 0, local%message)
+    end if
+  end subroutine pass_error
+
   subroutine add_expectation(err, what)
     type(error_t), intent(inout) :: err
     character(len=*), intent(in) :: what
@@ -136,11 +150,11 @@ contains
     flush (error_unit)
     call final_stop()
     ! A final-stop procedure must not return; make sure nothing runs on.
-    error stop 2
+    error stop 2, quiet=.true.
   end subroutine print_and_stop
 
   subroutine default_final_stop()
-    error stop 2
+    error stop 2, quiet=.true.
   end subroutine default_final_stop
 
 end module error_report

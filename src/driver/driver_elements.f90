@@ -4,6 +4,7 @@
 !> Each block's element forces are assembled into solver%f_int as soon as the block is done
 !> (parallel_assembly's block form: the same sums as the one-call assembly, in cache).
 module driver_elements
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
   use material_kinds, only: dp
   use error_report, only: raise_error
@@ -332,6 +333,11 @@ contains
        ! concatenation (an internal write of the whole message overflowed its buffer).
        write (text, '(a,i0,a,es12.5)') 'element ', blk%elem_number(e), ' at total time ', &
             solver%total_time + dt
+       if (.not. ieee_is_finite(w%volume_new(e))) then
+          ! not an inversion: the motion became NaN or Inf (loads or masses far out of scale)
+          call raise_error(trim(m%input_file), 0, trim(text) // ': its node coordinates became infinite or not a number; ' // &
+               'expected finite motion (look for loads, masses or material constants far out of scale)')
+       end if
        call raise_error(trim(m%input_file), 0, trim(text) // ': ' // inversion_reason_text(w%reason(e)) // &
             ' (increment too large, mesh too coarse for the deformation, or material too soft)')
     end if

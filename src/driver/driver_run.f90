@@ -23,6 +23,7 @@ module driver_run
        history_interval, sum_over_ranks
   use driver_checkpoint, only: save_checkpoint, load_checkpoint
   use driver_mass_scaling, only: apply_step_mass_scaling
+  use driver_finite, only: energies_finite, stop_non_finite, non_finite_flag
   use driver_stop_condition, only: stop_step_start, check_stop_condition, report_stop_condition
   use fem_cpe4r, only: cpe4r_char_length
   use fem_c3d8r, only: c3d8r_char_length
@@ -259,7 +260,11 @@ contains
       solver%increment = solver%increment + 1
       solver%step_increment = solver%step_increment + 1
       solver%dt_prev = dt
+      ! NaN or Inf stops the run now, on every rank (driver_finite: tested on the energy sums,
+      ! agreed through the minimum the increment takes anyway)
+      if (.not. energies_finite(solver)) dt_min = non_finite_flag
       call global_min(solver%part, dt_min)
+      if (dt_min <= non_finite_flag) call stop_non_finite(m, solver)
       solver%dt_stable = dt_min
       solver%dt_element = dt_elem
     end associate

@@ -11,7 +11,7 @@
 module scene_boundaries
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use keyword_reader, only: keyword_block_t, data_line_t, is_integer_text
+  use keyword_reader, only: keyword_block_t, data_line_t, is_integer_syntax
   use model, only: model_t
   use model_steps, only: boundary_t, bc_displacement, bc_velocity
   use model_amplitudes, only: amplitude_t
@@ -120,7 +120,7 @@ contains
          if (err%raised) return
          value = 0
          shorthand = field_name(dl, 2)
-         if (.not. is_integer_text(shorthand)) then
+         if (.not. is_integer_syntax(shorthand)) then
             if (nf > 2) then
                call raise_error(dl%file, dl%line, 'data beyond what *BOUNDARY takes after ' // &
                     shorthand // '; expected node or node set, ' // shorthand, err)

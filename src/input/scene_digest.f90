@@ -4,7 +4,7 @@
 !> so it may be changed for the continued run.
 module scene_digest
   use, intrinsic :: iso_fortran_env, only: int64
-  use keyword_reader, only: keyword_deck_t
+  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t
   use model_digest, only: scene_digest_t
   implicit none
   private
@@ -23,57 +23,58 @@ contains
   subroutine digest_deck(deck, d)
     type(keyword_deck_t), intent(in) :: deck
     type(scene_digest_t), intent(out) :: d
-    integer :: ib, k, j, n
-    character(len=:), allocatable :: text
+    integer :: ib, j, n, last_f
+    character(len=:), allocatable :: last_file
 
     n = 0
     do ib = 1, deck%n_blocks
        if (counted(deck%blocks(ib)%name)) n = n + 1 + deck%blocks(ib)%n_lines
     end do
     allocate (d%hash(n), d%line(n), d%file(n), d%files(0))
+    last_f = 0
+    last_file = ''
     n = 0
     do ib = 1, deck%n_blocks
        if (.not. counted(deck%blocks(ib)%name)) cycle
        associate (b => deck%blocks(ib))
-         text = '*' // b%name
-         if (allocated(b%params)) then
-            do k = 1, size(b%params)
-               text = text // field_mark // b%params(k)%name
-               if (b%params(k)%has_value) text = text // '=' // merge('"', ' ', b%params(k)%quoted) // &
-                    b%params(k)%value
-            end do
-         end if
          n = n + 1
-         call record(n, text, b%file, b%line)
+         call record_hash(n, keyword_hash(b), b%file, b%line)
          do j = 1, b%n_lines
-            text = ''
-            if (allocated(b%lines(j)%fields)) then
-               do k = 1, size(b%lines(j)%fields)
-                  text = text // field_mark // b%lines(j)%fields(k)%s
-               end do
-            end if
             n = n + 1
-            call record(n, text, b%lines(j)%file, b%lines(j)%line)
+            call record_hash(n, data_line_hash(b%lines(j)), b%lines(j)%file, b%lines(j)%line)
          end do
        end associate
     end do
 
   contains
 
-    subroutine record(i, text, file, line)
+    subroutine record_hash(i, hash, file, line)
       integer, intent(in) :: i, line
-      character(len=*), intent(in) :: text, file
+      integer(int64), intent(in) :: hash
+      character(len=*), intent(in) :: file
       integer :: f
 
-      d%hash(i) = line_hash(text)
+      d%hash(i) = hash
       d%line(i) = line
+      ! consecutive lines nearly always share their file: compare with the last one first
+      ! (a search of the 1024-character table for every line was a fifth of reading a big deck)
+      if (last_f > 0) then
+         if (len(file) == len(last_file)) then
+            if (file == last_file) then
+               d%file(i) = last_f
+               return
+            end if
+         end if
+      end if
       f = file_index(file)
       if (f == 0) then
          d%files = [character(len=1024) :: d%files, file]
          f = size(d%files)
       end if
       d%file(i) = f
-    end subroutine record
+      last_f = f
+      last_file = file
+    end subroutine record_hash
 
     integer function file_index(file) result(f)
       character(len=*), intent(in) :: file
@@ -92,18 +93,64 @@ contains
     counted = keyword /= 'RESTART'
   end function counted
 
-  pure integer(int64) function line_hash(text) result(h)
-    character(len=*), intent(in) :: text
-    integer(int64) :: a, b
-    integer :: i
+  !> The hash of a keyword line: hash of '*NAME' followed, for each parameter, by
+  !> field_mark, its name and '=' with the quote mark (or a blank) and the value, formed piece
+  !> by piece (a keyword line of 10 k parameters is not assembled).
+  integer(int64) function keyword_hash(blk) result(h)
+    type(keyword_block_t), intent(in) :: blk
+    integer(int64) :: a, b, total
+    integer :: k
 
     a = 1
     b = 7
+    call hash_add('*' // blk%name, a, b)
+    total = 1 + len(blk%name)
+    if (allocated(blk%params)) then
+       do k = 1, size(blk%params)
+          associate (p => blk%params(k))
+            call hash_add(field_mark // p%name, a, b)
+            total = total + len(field_mark) + len(p%name)
+            if (p%has_value) then
+               call hash_add('=' // merge('"', ' ', p%quoted) // p%value, a, b)
+               total = total + 2 + len(p%value)
+            end if
+          end associate
+       end do
+    end if
+    a = mod(a * mult_a + int(total), prime_a)
+    h = a * 2147483648_int64 + b
+  end function keyword_hash
+
+  !> The hash of a data line's fields, each after field_mark: the hash of their
+  !> concatenation, formed field by field (a line of 100 k fields is not assembled).
+  integer(int64) function data_line_hash(dl) result(h)
+    type(data_line_t), intent(in) :: dl
+    integer(int64) :: a, b, total
+    integer :: k
+    character(len=:), allocatable :: field
+
+    a = 1
+    b = 7
+    total = 0
+    do k = 1, dl%n_fields()
+       field = dl%field(k)
+       call hash_add(field_mark, a, b)
+       call hash_add(field, a, b)
+       total = total + len(field_mark) + len(field)
+    end do
+    ! the length at the end (as a default integer: the hashes stay those of earlier checkpoints)
+    a = mod(a * mult_a + int(total), prime_a)
+    h = a * 2147483648_int64 + b
+  end function data_line_hash
+
+  pure subroutine hash_add(text, a, b)
+    character(len=*), intent(in) :: text
+    integer(int64), intent(inout) :: a, b
+    integer :: i
+
     do i = 1, len(text)
        a = mod(a * mult_a + ichar(text(i:i)), prime_a)
        b = mod(b * mult_b + ichar(text(i:i)), prime_b)
     end do
-    a = mod(a * mult_a + len(text), prime_a)
-    h = a * 2147483648_int64 + b
-  end function line_hash
+  end subroutine hash_add
 end module scene_digest

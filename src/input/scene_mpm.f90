@@ -14,6 +14,7 @@
 !> materials, amplitudes, steps (*DYNAMIC, EXPLICIT, *DLOAD GRAV, *OUTPUT) are the usual ones.
 !> "Up" is +y (axis 2) in 2D and 3D. The checks end with `file:line: what; expected ...`.
 module scene_mpm
+  use, intrinsic :: iso_fortran_env, only: int64
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t
@@ -132,6 +133,8 @@ contains
               'one *PARTICLES, MATERIAL=...', err)
          return
       end if
+      call check_mpm_size(deck%blocks(grid_block), mpm, err)
+      if (err%raised) return
       ! steps: controls carry over; inflow belongs to its step; walls from their step on
       do s = 1, nsteps
          carry%inflow%on = .false.
@@ -192,6 +195,82 @@ contains
        end if
     end do
   end subroutine read_grid
+
+  !> The grid's node count and the particles of the regions, counted in floating point (they are
+  !> products of counts per axis: a small CELL overflowed the 32-bit node count and the run
+  !> crashed), against what the solver indexes (32-bit counts) and what the machine has: the
+  !> grid and particle arrays alone (a lower bound of the run's memory, on every rank: each
+  !> holds the whole grid) must fit in its physical memory. Said with the figures, at *MPM GRID.
+  subroutine check_mpm_size(blk, mpm, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(mpm_scene_t), intent(in) :: mpm
+    type(error_t), intent(inout) :: err
+    real(dp) :: nodes, particles, count, bytes, memory, dx
+    real(dp), parameter :: index_limit = 2147483647.0_dp
+    integer :: k, i, nd, ncomp
+    character(len=40) :: figure
+
+    nd = mpm%ndim
+    ncomp = merge(4, 6, nd == 2)
+    nodes = 1
+    do k = 1, nd
+       nodes = nodes * (real(ceiling((mpm%hi(k) - mpm%lo(k)) / mpm%cell - 1.0e-9_dp, int64), dp) + 1)
+    end do
+    particles = 0
+    do i = 1, size(mpm%regions)
+       dx = mpm%cell / mpm%regions(i)%ppc
+       count = 1
+       do k = 1, nd
+          count = count * (real(ceiling((mpm%regions(i)%hi(k) - mpm%lo(k)) / dx, int64) - &
+               floor((mpm%regions(i)%lo(k) - mpm%lo(k)) / dx, int64), dp) + 1)
+       end do
+       particles = particles + count
+    end do
+    if (nodes > index_limit) then
+       write (figure, '(es10.3)') nodes
+       call blk%fail('*MPM GRID, CELL=' // rtoa(mpm%cell) // ' makes ' // trim(adjustl(figure)) // ' grid nodes, ' // &
+            'more than the 2147483647 a run indexes; expected a larger CELL or a smaller grid', err)
+       return
+    end if
+    if (particles > index_limit) then
+       write (figure, '(es10.3)') particles
+       call blk%fail('the *PARTICLES regions of this grid (CELL=' // rtoa(mpm%cell) // ') hold ' // &
+            trim(adjustl(figure)) // ' particles, more than the 2147483647 a run indexes; expected a ' // &
+            'larger CELL, a smaller PPC or smaller regions', err)
+       return
+    end if
+    ! grid: mass, own mass, momentum, force, two velocities, active flag; particles: position,
+    ! velocity, stress, deformation gradient, mass and volume (8-byte reals)
+    bytes = nodes * (8 * (2 + 4 * nd) + 4) + particles * 8 * (2 * nd + ncomp + nd * nd + 2)
+    memory = physical_memory()
+    if (memory > 0 .and. bytes > memory) then
+       write (figure, '(f0.1,a,f0.1,a)') bytes / 2.0_dp**30, ' GiB; the machine has ', memory / 2.0_dp**30, ' GiB'
+       call blk%fail('*MPM GRID, CELL=' // rtoa(mpm%cell) // ': the grid (' // itoa(int(nodes)) // ' nodes) and ' // &
+            'the particles (' // itoa(int(particles)) // ') need at least ' // trim(figure) // &
+            '; expected a larger CELL or a smaller grid', err)
+    end if
+  end subroutine check_mpm_size
+
+  !> The machine's physical memory in bytes (MemTotal of /proc/meminfo), 0 when unknown.
+  real(dp) function physical_memory() result(bytes)
+    character(len=256) :: line
+    integer :: unit, ios
+    real(dp) :: kib
+
+    bytes = 0
+    open (newunit=unit, file='/proc/meminfo', status='old', action='read', iostat=ios)
+    if (ios /= 0) return
+    do
+       read (unit, '(a)', iostat=ios) line
+       if (ios /= 0) exit
+       if (line(1:9) == 'MemTotal:') then
+          read (line(10:), *, iostat=ios) kib
+          if (ios == 0) bytes = 1024 * kib
+          exit
+       end if
+    end do
+    close (unit)
+  end function physical_memory
 
   subroutine read_controls(blk, c, err)
     type(keyword_block_t), intent(in) :: blk

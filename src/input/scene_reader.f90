@@ -6,12 +6,13 @@
 !> keywords and their places (scene_layout), mesh, sets, materials, sections, amplitudes,
 !> interactions, surfaces and rigid bodies, initial conditions, steps.
 module scene_reader
-  use error_report, only: error_t
+  use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, read_keyword_file
   use scene_digest, only: digest_deck
   use model, only: model_t
   use scene_layout, only: scene_layout_t, scan_layout
   use scene_mesh, only: mesh_sources_t, build_mesh
+  use scene_geometry, only: check_element_geometry
   use scene_sets, only: build_sets
   use scene_materials, only: build_materials
   use scene_sections, only: build_sections
@@ -48,11 +49,9 @@ contains
     call read_keyword_file(path, deck, err)
     if (err%raised) return
     if (deck%n_blocks == 0) then
-       err%raised = .true.
-       err%file = path
-       err%line = 0
-       err%message = trim(path) // ': the scene is empty; expected Abaqus keywords (*NODE, ' // &
-            '*ELEMENT, *MATERIAL, *STEP, ...)'
+       ! file:1 - the place to start writing; a file of comments only says so too
+       call raise_error(path, 1, 'the scene is empty (no keyword line); expected Abaqus keywords ' // &
+            '(*NODE, *ELEMENT, *MATERIAL, *STEP, ...)', err)
        return
     end if
     call digest_deck(deck, model%digest)
@@ -84,6 +83,8 @@ contains
     call build_materials(deck, layout, model, user, err)
     if (err%raised) return
     call build_sections(deck, layout, sources, model, err)
+    if (err%raised) return
+    call check_element_geometry(deck, model, sources, err)
     if (err%raised) return
     call build_amplitudes(deck, model, err)
     if (err%raised) return

@@ -8,7 +8,7 @@
 !> the mesh is an error rather than a warning (it is almost always a typo).
 module scene_sets
   use error_report, only: error_t, raise_error
-  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_text
+  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_syntax
   use model, only: model_t
   use model_sets, only: index_set_t, find_set, name_length
   use scene_layout, only: scene_layout_t
@@ -204,7 +204,7 @@ contains
     if (len(name) == 0) then
        call raise_error(dl%file, dl%line, 'empty field ' // itoa(i) // &
             '; expected a node number or a node set name', err)
-    else if (is_integer_text(name)) then
+    else if (is_integer_syntax(name)) then
        call get_int(dl, i, id, err)
        if (err%raised) return
        k = model%mesh%node_index(id)
@@ -240,7 +240,7 @@ contains
     if (len(name) == 0) then
        call raise_error(dl%file, dl%line, 'empty field ' // itoa(i) // &
             '; expected an element number or an element set name', err)
-    else if (is_integer_text(name)) then
+    else if (is_integer_syntax(name)) then
        call get_int(dl, i, id, err)
        if (err%raised) return
        k = model%mesh%elem_index(id)

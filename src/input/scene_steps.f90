@@ -20,7 +20,7 @@
 module scene_steps
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_text
+  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_syntax
   use model, only: model_t
   use model_sets, only: find_set, name_length
   use model_steps, only: step_t, gravity_t, contact_pair_t, mass_scaling_t, mass_scaling_below_min, &
@@ -350,7 +350,7 @@ contains
          g%source = where_text(dl%file, dl%line)
          if (.not. field_blank(dl, 1)) then
             name = field_name(dl, 1)
-            if (is_integer_text(name)) then
+            if (is_integer_syntax(name)) then
                call raise_error(dl%file, dl%line, 'element number ' // name // ' on a *DLOAD line; ' // &
                     'expected an element set name or a blank field (whole model)', err)
                return
