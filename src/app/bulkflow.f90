@@ -24,6 +24,7 @@ program bulkflow
   type(run_options_t) :: opts
   character(len=:), allocatable :: scene
   logical :: check_only
+  integer :: i_note
   integer :: rank, nranks
 
   call MPI_Init()
@@ -38,6 +39,11 @@ program bulkflow
 
   call read_scene(scene, m, err)
   if (err%raised) call input_error_exit(err)
+  if (rank == 0 .and. allocated(m%notes)) then
+     do i_note = 1, size(m%notes)
+        write (output_unit, '(a)') 'bulkflow: ' // trim(m%notes(i_note))
+     end do
+  end if
   if (check_only) then
      if (rank == 0 .and. m%mpm%active) then
         write (output_unit, '(a,i0,a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (material points, ', &
