@@ -19,6 +19,7 @@ module scene_assembly
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, upper_case, is_integer_text
   use scene_util, only: itoa, where_text, field_blank
+  use scene_unsupported, only: unsupported_hint
   use scene_instance_map, only: instance_t, find_instance, rewrite_block, level_part, level_assembly, &
        level_model
   implicit none
@@ -82,7 +83,7 @@ contains
     integer, intent(out) :: n_parts, n_inst
     type(instance_t), allocatable, intent(out) :: instances(:)
     type(error_t), intent(inout) :: err
-    integer :: i, part, inst, assembly, n_assemblies, k
+    integer :: i, part, inst, assembly, n_assemblies, k, loose_mesh
     character(len=:), allocatable :: name, part_name
 
     allocate (zone(deck%n_blocks), owner(deck%n_blocks), parts(deck%n_blocks), instances(deck%n_blocks))
@@ -94,12 +95,13 @@ contains
     inst = 0
     assembly = 0
     n_assemblies = 0
+    loose_mesh = 0
     do i = 1, deck%n_blocks
        associate (blk => deck%blocks(i))
          select case (blk%name)
          case ('PART')
             if (part /= 0 .or. assembly /= 0) then
-               call blk%fail('*PART inside ' // merge('*PART    ', '*ASSEMBLY', part /= 0) // ' started at ' // &
+               call blk%fail('*PART inside ' // trim(merge('*PART    ', '*ASSEMBLY', part /= 0)) // ' started at ' // &
                     where_text(deck%blocks(max(part, assembly))%file, deck%blocks(max(part, assembly))%line) // &
                     '; expected *END PART / *END ASSEMBLY first', err)
                return
@@ -182,19 +184,22 @@ contains
          case default
             if (part /= 0 .or. inst /= 0) then
                if (.not. is_part_keyword(blk%name)) then
-                  call blk%fail('*' // blk%name // ' inside a ' // merge('*PART    ', '*INSTANCE', part /= 0) // &
-                       ' is not supported; expected *NODE, *ELEMENT, *NSET, *ELSET, *SURFACE, *SOLID SECTION ' // &
-                       'or *RIGID BODY there (and the rest in the *ASSEMBLY or the model)', err)
+                  if (len(unsupported_hint(blk%name)) > 0) then
+                     call blk%fail('*' // blk%name // ' is not simulated by bulkflow; ' // &
+                          unsupported_hint(blk%name), err)
+                  else
+                     call blk%fail('*' // blk%name // ' inside a ' // trim(merge('*PART    ', '*INSTANCE', &
+                          part /= 0)) // ' is not supported; expected *NODE, *ELEMENT, *NSET, *ELSET, *SURFACE, ' // &
+                          '*SOLID SECTION or *RIGID BODY there (and the rest in the *ASSEMBLY or the model)', err)
+                  end if
                   return
                end if
                zone(i) = merge(in_part, in_instance, part /= 0)
                owner(i) = merge(n_parts, inst, part /= 0)
             else if (assembly /= 0) then
                zone(i) = in_assembly
-            else if (blk%name == 'NODE' .or. blk%name == 'ELEMENT') then
-               call blk%fail('*' // blk%name // ' outside the parts and the assembly of a model that has ' // &
-                    'them; expected it inside *PART ... *END PART (or *NODE in the *ASSEMBLY)', err)
-               return
+            else if ((blk%name == 'NODE' .or. blk%name == 'ELEMENT') .and. loose_mesh == 0) then
+               loose_mesh = i   ! reported once the frame itself is known to be sound
             end if
          end select
        end associate
@@ -207,6 +212,10 @@ contains
     else if (assembly /= 0) then
        call deck%blocks(assembly)%fail('*END ASSEMBLY missing for this *ASSEMBLY; expected *ASSEMBLY ... ' // &
             '*END ASSEMBLY', err)
+    else if (loose_mesh /= 0) then
+       call deck%blocks(loose_mesh)%fail('*' // deck%blocks(loose_mesh)%name // ' outside the parts and the ' // &
+            'assembly of a model that has them; expected it inside *PART ... *END PART (or *NODE in the ' // &
+            '*ASSEMBLY)', err)
     end if
   end subroutine scan_frames
 
