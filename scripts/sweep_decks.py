@@ -3,6 +3,7 @@
 
     python3 scripts/sweep_decks.py --bulkflow build/bin/bulkflow DIR_OR_DECK... [--report out.tsv]
                                    [--timeout 60] [--run-increments 20] [--jobs 2]
+    python3 scripts/sweep_decks.py --get docs/deck_sweep_sources.tsv --into /tmp   # fetch the decks first
 
 For every *.inp found (directories are searched recursively), `bulkflow DECK --check` runs
 (timeout). A deck it accepts is also run, unchanged, for a few increments
@@ -14,7 +15,10 @@ For every *.inp found (directories are searched recursively), `bulkflow DECK --c
   * an accepted deck whose short run fails.
 It prints the counts: accepted (and run), rejected by reason (the keyword or the feature the
 message names), failures. The decks themselves are not part of the repository: the sources
-are listed in tests/sweep/deck_sources.md (repository, path, commit) with how to get them.
+are listed in docs/deck_sweep_sources.tsv (set, local name, repository, path, commit) and
+docs/deck_sweep.md gives the counts of the last sweep. `--get` clones each listed repository
+(blobless, from github.com) and writes every listed file, at its commit, to
+INTO/<set>_decks/<local name>.
 """
 from __future__ import annotations
 
@@ -107,15 +111,52 @@ def sweep_one(deck: Path, bulkflow: str, timeout: float, increments: int) -> dic
         return {**result, 'status': 'accepted', 'reason': 'ran', 'detail': out.strip().splitlines()[-1][:120] if out.strip() else ''}
 
 
+def get_decks(sources: Path, into: Path, url: str = 'https://github.com/{repo}.git') -> int:
+    """Fetch the decks listed in SOURCES (TSV: set, local, repository, path, commit) into INTO."""
+    rows = [line.split('\t') for line in sources.read_text().splitlines()[1:] if line.strip()]
+    by_repo: dict[str, list[list[str]]] = collections.defaultdict(list)
+    for row in rows:
+        by_repo[row[2]].append(row)
+    missing = 0
+    with tempfile.TemporaryDirectory(prefix='bulkflow_decks_') as tmp:
+        for repo, items in sorted(by_repo.items()):
+            clone = Path(tmp) / repo.replace('/', '+')
+            p = subprocess.run(['git', 'clone', '--quiet', '--filter=blob:none', '--no-checkout',
+                                url.format(repo=repo, owner=repo.split('/')[0], name=repo.split('/')[1]), str(clone)], capture_output=True, text=True)
+            if p.returncode != 0:
+                print(f'cannot clone {repo}: {p.stderr.strip()}')
+                missing += len(items)
+                continue
+            for kind, local, _, path, commit in items:
+                out = into / f'{kind}_decks' / local
+                out.parent.mkdir(parents=True, exist_ok=True)
+                blob = subprocess.run(['git', '-C', str(clone), 'show', f'{commit}:{path}'], capture_output=True)
+                if blob.returncode != 0:
+                    print(f'missing {repo} {commit[:10]} {path}')
+                    missing += 1
+                    continue
+                out.write_bytes(blob.stdout)
+    print(f'{len(rows) - missing} of {len(rows)} decks written under {into}')
+    return 1 if missing else 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    ap.add_argument('paths', nargs='+', type=Path)
-    ap.add_argument('--bulkflow', required=True)
+    ap.add_argument('paths', nargs='*', type=Path)
+    ap.add_argument('--bulkflow')
+    ap.add_argument('--get', type=Path, metavar='SOURCES', help='fetch the decks listed in SOURCES (TSV) and stop')
+    ap.add_argument('--into', type=Path, default=Path('/tmp'), help='with --get: where <set>_decks/ go')
+    ap.add_argument('--url', default='https://github.com/{repo}.git',
+                    help='with --get: where to clone from ({repo}, {owner}, {name} are replaced)')
     ap.add_argument('--timeout', type=float, default=60)
     ap.add_argument('--run-increments', type=int, default=20)
     ap.add_argument('--jobs', type=int, default=2)
     ap.add_argument('--report', type=Path, help='write one line per deck (TSV)')
     a = ap.parse_args(argv)
+    if a.get:
+        return get_decks(a.get, a.into, a.url)
+    if not a.paths or not a.bulkflow:
+        ap.error('give --bulkflow and at least one deck or directory (or --get SOURCES)')
     a.bulkflow = str(Path(a.bulkflow).resolve()) if os.sep in a.bulkflow else a.bulkflow
     decks = decks_of(a.paths)
     if not decks:

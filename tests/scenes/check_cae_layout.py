@@ -2,13 +2,15 @@
 """The default wedge hopper written as Abaqus/CAE writes decks (parts, an assembly, instances, the
 analytic rigid walls as parts of their own) must give the results of the flat deck bit for bit.
 
-    check_cae_layout.py FLAT.inp --bulkflow BIN --workdir DIR [--period T]
+    check_cae_layout.py FLAT.inp --bulkflow BIN --workdir DIR [--period T] [--committed CAE.inp]
 
 The flat deck (its step period shortened to T for a short run) and two CAE-layout versions
 written by bulkflow.scenes.cae_layout are run: walls at the assembly level (same names: the
 history CSV must be byte-identical) and walls as instances of their own parts (names qualified,
 `WALL-1.WALL`: the history must be identical once the wall columns are renamed). In both, every
 dataset and attribute of the .h5 must be identical (h5py, exact), and nothing may be NaN.
+--committed: the CAE-layout deck kept in the repository (inputs/demo/wedge_hopper_cae.inp) must be
+exactly what bulkflow.scenes.cae_layout writes from FLAT, and it is run too (period shortened).
 """
 from __future__ import annotations
 
@@ -71,6 +73,7 @@ def main() -> int:
     p.add_argument('--bulkflow', required=True)
     p.add_argument('--workdir', type=Path, required=True)
     p.add_argument('--period', type=float, default=0.01)
+    p.add_argument('--committed', type=Path, help='the CAE-layout deck in the repository (walls as instances)')
     a = p.parse_args()
     a.workdir.mkdir(parents=True, exist_ok=True)
     flat = with_period(a.flat, a.workdir / 'flat.inp', a.period)
@@ -80,11 +83,22 @@ def main() -> int:
         print('FAIL: NaN in the flat run history')
         return 1
     failures = 0
-    for walls in ('assembly', 'instance'):
-        deck = convert(a.flat, a.workdir / f'cae_{walls}.inp', period=a.period, walls=walls)
+    variants = ['assembly', 'instance']
+    if a.committed:
+        written = convert(a.flat, a.workdir / a.committed.name, walls='instance').read_text()
+        current = written == a.committed.read_text()
+        print(f'{a.committed.name}: {"is" if current else "is NOT"} what bulkflow.scenes.cae_layout writes from '
+              f'{a.flat.name}' + ('' if current else ' (regenerate it)'))
+        failures += not current
+        variants.append('committed')
+    for walls in variants:
+        if walls == 'committed':
+            deck = with_period(a.committed, a.workdir / 'cae_committed.inp', a.period)
+        else:
+            deck = convert(a.flat, a.workdir / f'cae_{walls}.inp', period=a.period, walls=walls)
         stdout = run(a.bulkflow, deck, a.workdir / f'cae_{walls}')
         history = (a.workdir / f'cae_{walls}_history.csv').read_text()
-        if walls == 'instance':
+        if walls in ('instance', 'committed'):
             header, rest = history.split('\n', 1)
             header = header.replace('_WALL-1.WALL', '_WALL').replace('_PLATE-1.PLATE', '_PLATE')
             history = header + '\n' + rest

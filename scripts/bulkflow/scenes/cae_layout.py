@@ -98,7 +98,9 @@ def convert(flat: Path, out: Path, instance: str = 'FILL-1', period: float | Non
     heading = [b for b in model if b.name == 'HEADING']
     for b in heading:
         lines += b.text()
-    lines += ['*Preprint, echo=NO, model=NO, history=NO, contact=NO', '**', '** PARTS', '**',
+    lines += [f'** {flat.name} in the layout Abaqus/CAE writes (parts, an assembly, instances, analytic',
+              '** rigid parts); written by bulkflow.scenes.cae_layout: same model, same results.',
+              '*Preprint, echo=NO, model=NO, history=NO, contact=NO', '**', '** PARTS', '**',
               f'*Part, name={instance.rsplit("-", 1)[0]}']
     for b in model:
         if b.name in PART_KEYWORDS and not (b.name == 'NODE' and b.param('NSET').upper() in ref_sets):
