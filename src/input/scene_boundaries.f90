@@ -140,10 +140,12 @@ contains
          end if
          if (first >= 1 .and. last >= first .and. last > ndim .and. last <= 6) then
             ! dofs beyond the translations: only on rigid-body reference nodes, only held
-            call held_rotations(model, dl, nodes, first, last, value, err)
-            if (err%raised) return
-            if (first > ndim) cycle
-            last = ndim
+            if (all_reference_nodes(model, nodes)) then
+               call held_rotations(model, dl, first, last, value, err)
+               if (err%raised) return
+               if (first > ndim) cycle
+               last = ndim
+            end if
          end if
          if (first < 1 .or. last < first .or. last > ndim) then
             call raise_error(dl%file, dl%line, 'degrees of freedom ' // itoa(first) // '..' // itoa(last) // &
@@ -181,29 +183,35 @@ contains
     end select
   end subroutine antisymmetry
 
-  !> dofs beyond ndim on a *BOUNDARY line: Abaqus's rotations (4..6; and 3 of a 2D reference
-  !> node). Our rigid bodies translate only, so their rotations are held already: accepted on
-  !> reference nodes with a zero value; elsewhere, or non-zero, refused.
-  subroutine held_rotations(model, dl, nodes, first, last, value, err)
+  !> Every node is the reference node of a *RIGID BODY.
+  pure logical function all_reference_nodes(model, nodes)
     type(model_t), intent(in) :: model
-    type(data_line_t), intent(in) :: dl
-    integer, intent(in) :: nodes(:), first, last
-    real(dp), intent(in) :: value
-    type(error_t), intent(inout) :: err
+    integer, intent(in) :: nodes(:)
     integer :: j
 
+    all_reference_nodes = size(nodes) > 0
     do j = 1, size(nodes)
        if (.not. any(model%rigid_surfaces(1:model%n_rigid_surfaces)%ref_node == nodes(j))) then
-          call raise_error(dl%file, dl%line, 'degrees of freedom ' // itoa(first) // '..' // itoa(last) // &
-               ' on node ' // itoa(model%mesh%node_id(nodes(j))) // ', which is not a *RIGID BODY reference ' // &
-               'node; expected dofs 1..' // itoa(model%mesh%ndim) // ' (continuum nodes have no rotations)', err)
+          all_reference_nodes = .false.
           return
        end if
     end do
+  end function all_reference_nodes
+
+  !> dofs beyond ndim on reference nodes: Abaqus's rotations (4..6; and 3 of a 2D reference
+  !> node). Our rigid bodies translate only, so their rotations are held already: accepted with
+  !> a zero value, refused otherwise.
+  subroutine held_rotations(model, dl, first, last, value, err)
+    type(model_t), intent(in) :: model
+    type(data_line_t), intent(in) :: dl
+    integer, intent(in) :: first, last
+    real(dp), intent(in) :: value
+    type(error_t), intent(inout) :: err
+
     if (abs(value) > 0) then
-       call raise_error(dl%file, dl%line, 'a non-zero value on rotation dofs of a rigid body: rigid-body ' // &
-            'rotation is not simulated (our rigid walls translate); expected 0 (held) or dofs 1..' // &
-            itoa(model%mesh%ndim), err)
+       call raise_error(dl%file, dl%line, 'a non-zero value on dofs ' // itoa(first) // '..' // itoa(last) // &
+            ' of a rigid-body reference node: rigid-body rotation is not simulated (our rigid walls ' // &
+            'translate); expected 0 (held) or dofs 1..' // itoa(model%mesh%ndim), err)
     end if
   end subroutine held_rotations
 

@@ -144,8 +144,9 @@ contains
             else if (kind_b == 'ELEMENT' .and. kind_a /= 'ELEMENT' .and. kind_a /= '') then
                call swap(a, b)
             else if (kind_a == '' .or. kind_b == '') then
-               call raise_error(dl%file, dl%line, 'surface ' // merge(a, b, kind_a == '') // ' is not defined; ' // &
-                    'expected a *SURFACE, NAME=' // merge(a, b, kind_a == ''), err)
+               if (kind_a /= '') call swap(a, b)
+               call raise_error(dl%file, dl%line, 'surface ' // a // ' is not defined; expected a *SURFACE, NAME=' // &
+                    a, err)
                return
             else
                call raise_error(dl%file, dl%line, 'contact between ' // a // ' and ' // b // ' (' // kind_a // &
