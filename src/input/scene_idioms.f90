@@ -68,7 +68,7 @@ contains
     character(len=*), intent(in) :: text
 
     if (.not. allocated(notes)) allocate (notes(0))
-    notes = [notes, [character(len=512) :: text]]
+    notes = [character(len=512) :: notes, text]
   end subroutine add_note
 
   !> Drop print/file requests; an *OUTPUT left with no option and no VARIABLE= goes too.
@@ -76,7 +76,7 @@ contains
     type(keyword_deck_t), intent(in) :: deck
     logical, intent(inout) :: keep(:)
     character(len=512), allocatable, intent(inout) :: notes(:)
-    character(len=:), allocatable :: reason
+    character(len=:), allocatable :: reason, times
     integer :: i, j, count_same, last_output
     logical :: options_left
 
@@ -93,9 +93,10 @@ contains
        do j = i, deck%n_blocks
           if (deck%blocks(j)%name == deck%blocks(i)%name) count_same = count_same + 1
        end do
+       times = ''
+       if (count_same > 1) times = ' (x' // itoa(count_same) // ')'
        call add_note(notes, where_text(deck%blocks(i)%file, deck%blocks(i)%line) // ': note: *' // &
-            deck%blocks(i)%name // trim(merge(' (x' // itoa(count_same) // ')', '           ', count_same > 1)) // &
-            ' accepted and not acted on: ' // reason)
+            deck%blocks(i)%name // times // ' accepted and not acted on: ' // reason)
     end do
     ! An *OUTPUT whose only options were dropped requests nothing any more.
     last_output = 0
