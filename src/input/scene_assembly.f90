@@ -18,7 +18,7 @@ module scene_assembly
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, upper_case, is_integer_text
-  use scene_util, only: itoa, where_text, field_blank
+  use scene_util, only: itoa, where_text, field_blank, push_block
   use scene_unsupported, only: unsupported_hint
   use scene_instance_map, only: instance_t, find_instance, rewrite_block, level_part, level_assembly, &
        level_model
@@ -71,6 +71,7 @@ contains
     if (err%raised) return
     call number_instances(deck, zone, owner, parts, instances, n_inst, asm, err)
     if (err%raised) return
+    asm%prefix = assembly_prefix(deck)
     call emit_flat(deck, zone, owner, parts, instances, n_inst, asm, err)
   end subroutine flatten_assembly
 
@@ -218,6 +219,22 @@ contains
             '*ASSEMBLY)', err)
     end if
   end subroutine scan_frames
+
+  !> 'NAME.' of the *ASSEMBLY (upper case; '' without NAME=).
+  function assembly_prefix(deck) result(prefix)
+    type(keyword_deck_t), intent(in) :: deck
+    character(len=:), allocatable :: prefix
+    integer :: i, k
+
+    prefix = ''
+    do i = 1, deck%n_blocks
+       if (deck%blocks(i)%name /= 'ASSEMBLY' .or. .not. allocated(deck%blocks(i)%params)) cycle
+       do k = 1, size(deck%blocks(i)%params)
+          if (deck%blocks(i)%params(k)%name == 'NAME') prefix = upper_case(deck%blocks(i)%params(k)%value) // '.'
+       end do
+    end do
+    if (prefix == '.') prefix = ''
+  end function assembly_prefix
 
   pure integer function find_part(parts, n, name)
     type(part_t), intent(in) :: parts(:)
@@ -397,15 +414,8 @@ contains
       type(keyword_block_t), intent(in) :: blk
       integer, intent(in) :: level
       type(instance_t), intent(in) :: inst
-      type(keyword_block_t), allocatable :: tmp(:)
 
-      if (n_out == size(out)) then
-         allocate (tmp(2 * n_out))
-         tmp(1:n_out) = out(1:n_out)
-         call move_alloc(tmp, out)
-      end if
-      n_out = n_out + 1
-      out(n_out) = blk
+      call push_block(out, n_out, blk)
       call rewrite_block(out(n_out), level, inst, instances, n_inst, asm, err)
     end subroutine push
   end subroutine emit_flat

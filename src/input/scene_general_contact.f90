@@ -8,7 +8,7 @@
 module scene_general_contact
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, upper_case
-  use scene_util, only: field_name, field_blank
+  use scene_util, only: field_name, field_blank, push_block
   implicit none
   private
 
@@ -45,7 +45,7 @@ contains
             return
          end if
          if (blk%name /= 'CONTACT') then
-            call push(blk)
+            call push_block(out, n_out, blk)
             cycle
          end if
          last = 0
@@ -64,7 +64,7 @@ contains
          call pairs_of(deck, i, last, pairs, err)
          if (err%raised) return
          do j = 1, size(pairs)
-            call push(pairs(j))
+            call push_block(out, n_out, pairs(j))
          end do
        end associate
        if (last > i) i = last
@@ -72,20 +72,6 @@ contains
     deck%blocks = out(1:n_out)
     deck%n_blocks = n_out
 
-  contains
-
-    subroutine push(b)
-      type(keyword_block_t), intent(in) :: b
-      type(keyword_block_t), allocatable :: tmp(:)
-
-      if (n_out == size(out)) then
-         allocate (tmp(2 * n_out))
-         tmp(1:n_out) = out(1:n_out)
-         call move_alloc(tmp, out)
-      end if
-      n_out = n_out + 1
-      out(n_out) = b
-    end subroutine push
   end subroutine convert_general_contact
 
   pure function itext(i) result(t)

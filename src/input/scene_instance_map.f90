@@ -25,6 +25,8 @@ module scene_instance_map
      logical :: moved = .false.              !< a non-zero translation or a rotation
      logical :: rotated = .false.            !< rot and axis_point hold a rotation
      real(dp) :: shift(3) = 0, rot(3, 3) = 0, axis_point(3) = 0
+     !> assembly level only: 'ASSEMBLY-NAME.', the prefix Abaqus allows on assembly names
+     character(len=:), allocatable :: prefix
   end type instance_t
 
   !> Where a block stands: in a part (names qualified, numbers offset by the instance),
@@ -89,7 +91,10 @@ contains
     character(len=:), allocatable :: kind
 
     owner = inst
-    if (level /= level_part) owner = asm
+    if (level /= level_part) then
+       owner = asm
+       call strip_assembly_prefix(blk, asm)
+    end if
     ! INSTANCE= on an assembly-level set or surface: its numbers and names are the instance's.
     ip = param_position(blk, 'INSTANCE')
     if (ip > 0) then
@@ -130,6 +135,33 @@ contains
        if (err%raised) return
     end do
   end subroutine rewrite_block
+
+  !> `Assembly.Set` -> `Set` in parameters and data fields outside the parts.
+  subroutine strip_assembly_prefix(blk, asm)
+    type(keyword_block_t), intent(inout) :: blk
+    type(instance_t), intent(in) :: asm
+    integer :: i, il, n
+
+    if (.not. allocated(asm%prefix)) return
+    n = len(asm%prefix)
+    if (n == 0) return
+    if (allocated(blk%params)) then
+       do i = 1, size(blk%params)
+          if (len(blk%params(i)%value) > n) then
+             if (upper_case(blk%params(i)%value(1:n)) == asm%prefix) blk%params(i)%value = blk%params(i)%value(n + 1:)
+          end if
+       end do
+    end if
+    do il = 1, blk%n_lines
+       do i = 1, blk%lines(il)%n_fields()
+          associate (f => blk%lines(il)%fields(i)%s)
+            if (len(f) > n) then
+               if (upper_case(f(1:n)) == asm%prefix) blk%lines(il)%fields(i)%s = f(n + 1:)
+            end if
+          end associate
+       end do
+    end do
+  end subroutine strip_assembly_prefix
 
   pure integer function param_position(blk, name)
     type(keyword_block_t), intent(in) :: blk
@@ -187,7 +219,14 @@ contains
        associate (p => blk%params(i))
          select case (p%name)
          case ('NSET', 'ELSET', 'ANALYTICAL SURFACE')
-            if (level == level_part .or. owner%part /= 0) p%value = qualified(owner, p%value)
+            ! The name an *NSET or *ELSET defines is the instance's only inside a part; at the
+            ! assembly level (INSTANCE= or not) it is an assembly name. Names it refers to
+            ! are the instance's under INSTANCE=.
+            if (level == level_part) then
+               p%value = qualified(owner, p%value)
+            else if (owner%part /= 0 .and. p%name /= blk%name) then
+               p%value = qualified(owner, p%value)
+            end if
          case ('NAME')
             if (blk%name == 'SURFACE' .and. level == level_part) p%value = qualified(owner, p%value)
          case ('REF NODE')
