@@ -24,7 +24,7 @@ program bulkflow
   type(run_options_t) :: opts
   character(len=:), allocatable :: scene
   logical :: check_only
-  integer :: rank, nranks, iw
+  integer :: rank, nranks, iw, i_note
 
   call MPI_Init()
   call MPI_Comm_rank(MPI_COMM_WORLD, rank)
@@ -41,6 +41,11 @@ program bulkflow
   if (rank == 0 .and. allocated(m%warnings)) then
      do iw = 1, size(m%warnings)
         write (error_unit, '(a)') 'bulkflow: warning: ' // trim(m%warnings(iw))
+     end do
+  end if
+  if (rank == 0 .and. allocated(m%notes)) then
+     do i_note = 1, size(m%notes)
+        write (output_unit, '(a)') 'bulkflow: ' // trim(m%notes(i_note))
      end do
   end if
   if (check_only) then

@@ -41,7 +41,8 @@ module driver_output
   end type run_output_t
 
   public :: open_run_output, close_run_output, step_output_start, output_due, write_frame, &
-       write_history, energy_values, progress_line, field_interval, history_interval, sum_over_ranks
+       write_history, energy_values, progress_line, field_interval, history_interval, &
+       output_frequency, sum_over_ranks
 
 contains
 
@@ -165,9 +166,11 @@ contains
     type(model_t), intent(in) :: m
     integer, intent(in) :: istep
     integer :: j
+    logical :: by_time
 
     history_interval = m%steps(istep)%period / default_history_points
     if (.not. allocated(m%steps(istep)%history_outputs)) return
+    by_time = size(m%steps(istep)%history_outputs) == 0
     do j = 1, size(m%steps(istep)%history_outputs)
        associate (h => m%steps(istep)%history_outputs(j))
          if (h%time_interval > 0) then
@@ -175,9 +178,37 @@ contains
          else if (h%number_interval > 0) then
             history_interval = min(history_interval, m%steps(istep)%period / h%number_interval)
          end if
+         if (h%frequency == 0) by_time = .true.
        end associate
     end do
+    ! Only FREQUENCY= requests: rows by increment count alone.
+    if (.not. by_time) history_interval = 0
   end function history_interval
+
+  !> The smallest FREQUENCY= (every n increments) of the step's field (`field`) or history
+  !> requests; 0 when none asks for one.
+  integer function output_frequency(m, istep, field)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: istep
+    logical, intent(in) :: field
+    integer :: j
+
+    output_frequency = 0
+    if (field .and. allocated(m%steps(istep)%field_outputs)) then
+       do j = 1, size(m%steps(istep)%field_outputs)
+          call take(m%steps(istep)%field_outputs(j)%frequency)
+       end do
+    else if (.not. field .and. allocated(m%steps(istep)%history_outputs)) then
+       do j = 1, size(m%steps(istep)%history_outputs)
+          call take(m%steps(istep)%history_outputs(j)%frequency)
+       end do
+    end if
+  contains
+    subroutine take(f)
+      integer, intent(in) :: f
+      if (f > 0 .and. (output_frequency == 0 .or. f < output_frequency)) output_frequency = f
+    end subroutine take
+  end function output_frequency
 
   !> At the start of a step: first frame and row at its start time.
   subroutine step_output_start(out)

@@ -20,7 +20,7 @@ module driver_run
        apply_rigid_body_velocities, gravity_forces, apply_contact, gravity_varies_in_step
   use driver_output, only: run_output_t, open_run_output, close_run_output, step_output_start, &
        output_due, write_frame, write_history, energy_values, progress_line, field_interval, &
-       history_interval, sum_over_ranks
+       history_interval, output_frequency, sum_over_ranks
   use driver_checkpoint, only: save_checkpoint, load_checkpoint
   use driver_mass_scaling, only: apply_step_mass_scaling
   use driver_finite, only: energies_finite, stop_non_finite, non_finite_flag
@@ -519,24 +519,38 @@ contains
     type(effects_t), intent(inout) :: effects
     integer, intent(in) :: istep
     real(dp) :: period, interval
+    integer :: frequency
+    logical :: due, step_end
 
     period = m%steps(istep)%period
     call effects%start(effect_output)
+    ! FREQUENCY=n requests: every n-th increment of the step and the step's end.
+    step_end = solver%step_time >= period * (1 - 1.0e-12_dp)
     interval = field_interval(m, istep)
-    if (interval > 0) then
-       if (output_due(solver%step_time, out%next_field, period, solver%dt)) then
-          call write_frame(m, solver, out, istep)
+    frequency = output_frequency(m, istep, .true.)
+    due = .false.
+    if (interval > 0) due = output_due(solver%step_time, out%next_field, period, solver%dt)
+    if (frequency > 0) due = due .or. mod(solver%step_increment, frequency) == 0 .or. step_end
+    if (due) then
+       call write_frame(m, solver, out, istep)
+       if (interval > 0) then
           do while (out%next_field <= solver%step_time + 1.0e-9_dp * period)
              out%next_field = out%next_field + interval
           end do
        end if
     end if
     interval = history_interval(m, istep)
-    if (output_due(solver%step_time, out%next_history, period, solver%dt)) then
+    frequency = output_frequency(m, istep, .false.)
+    due = .false.
+    if (interval > 0) due = output_due(solver%step_time, out%next_history, period, solver%dt)
+    if (frequency > 0) due = due .or. mod(solver%step_increment, frequency) == 0 .or. step_end
+    if (due) then
        call write_history(m, solver, out, istep)
-       do while (out%next_history <= solver%step_time + 1.0e-9_dp * period)
-          out%next_history = out%next_history + interval
-       end do
+       if (interval > 0) then
+          do while (out%next_history <= solver%step_time + 1.0e-9_dp * period)
+             out%next_history = out%next_history + interval
+          end do
+       end if
     end if
     call effects%stop(effect_output)
   end subroutine write_outputs

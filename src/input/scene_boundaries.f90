@@ -136,9 +136,19 @@ contains
             case ('YSYMM'); first = 2; last = 2
             case ('ZSYMM'); first = 3; last = 3
             case ('PINNED', 'ENCASTRE'); first = 1; last = ndim
+            case ('XASYMM', 'YASYMM', 'ZASYMM')
+               ! antisymmetry about a plane x, y or z = const: the two in-plane translations held
+               ! (the rotation about the normal: none on our nodes)
+               call antisymmetry(shorthand, ndim, first, last)
+               if (shorthand == 'YASYMM' .and. ndim == 3) then
+                  call add_atoms(st, nodes, 1, 1, kind, value, amp, where_text(dl%file, dl%line))
+                  first = 3
+                  last = 3
+               end if
             case default
                call raise_error(dl%file, dl%line, 'boundary type "' // dl%field(2) // '" is not ' // &
-                    'supported; expected a dof number or XSYMM, YSYMM, ZSYMM, PINNED, ENCASTRE', err)
+                    'supported; expected a dof number or XSYMM, YSYMM, ZSYMM, XASYMM, YASYMM, ZASYMM, ' // &
+                    'PINNED, ENCASTRE', err)
                return
             end select
          else
@@ -147,10 +157,19 @@ contains
             if (.not. err%raised) call get_real(dl, 4, value, err, default=0.0_dp)
             if (err%raised) return
          end if
+         if (first >= 1 .and. last >= first .and. last > ndim .and. last <= 6) then
+            ! dofs beyond the translations: only on rigid-body reference nodes, only held
+            if (all_reference_nodes(model, nodes)) then
+               call held_rotations(model, dl, first, last, value, err)
+               if (err%raised) return
+               if (first > ndim) cycle
+               last = ndim
+            end if
+         end if
          if (first < 1 .or. last < first .or. last > ndim) then
             call raise_error(dl%file, dl%line, 'degrees of freedom ' // itoa(first) // '..' // itoa(last) // &
                  ' are not translations of this ' // itoa(ndim) // 'D model; expected 1 <= first <= last <= ' // &
-                 itoa(ndim), err)
+                 itoa(ndim) // ' (up to 6 on a *RIGID BODY reference node, rotations held)', err)
             return
          end if
          if (.not. in_step .and. abs(value) > 0) then
@@ -162,6 +181,58 @@ contains
        end associate
     end do
   end subroutine read_boundary
+
+  !> XASYMM, YASYMM, ZASYMM: the translations in the plane of antisymmetry (YASYMM in 3D is
+  !> dofs 1 and 3: the caller adds dof 1 and this gives 3).
+  pure subroutine antisymmetry(shorthand, ndim, first, last)
+    character(len=*), intent(in) :: shorthand
+    integer, intent(in) :: ndim
+    integer, intent(out) :: first, last
+
+    select case (shorthand)
+    case ('XASYMM')
+       first = 2
+       last = ndim
+    case ('YASYMM')
+       first = 1
+       last = 1
+    case default
+       first = 1
+       last = 2
+    end select
+  end subroutine antisymmetry
+
+  !> Every node is the reference node of a *RIGID BODY.
+  pure logical function all_reference_nodes(model, nodes)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: nodes(:)
+    integer :: j
+
+    all_reference_nodes = size(nodes) > 0
+    do j = 1, size(nodes)
+       if (.not. any(model%rigid_surfaces(1:model%n_rigid_surfaces)%ref_node == nodes(j))) then
+          all_reference_nodes = .false.
+          return
+       end if
+    end do
+  end function all_reference_nodes
+
+  !> dofs beyond ndim on reference nodes: Abaqus's rotations (4..6; and 3 of a 2D reference
+  !> node). Our rigid bodies translate only, so their rotations are held already: accepted with
+  !> a zero value, refused otherwise.
+  subroutine held_rotations(model, dl, first, last, value, err)
+    type(model_t), intent(in) :: model
+    type(data_line_t), intent(in) :: dl
+    integer, intent(in) :: first, last
+    real(dp), intent(in) :: value
+    type(error_t), intent(inout) :: err
+
+    if (abs(value) > 0) then
+       call raise_error(dl%file, dl%line, 'a non-zero value on dofs ' // itoa(first) // '..' // itoa(last) // &
+            ' of a rigid-body reference node: rigid-body rotation is not simulated (our rigid walls ' // &
+            'translate); expected 0 (held) or dofs 1..' // itoa(model%mesh%ndim), err)
+    end if
+  end subroutine held_rotations
 
   !> OP=MOD semantics: a (node, dof) named again gets the new condition.
   subroutine add_atoms(st, nodes, first, last, kind, value, amp, source)

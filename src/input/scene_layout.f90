@@ -9,6 +9,7 @@ module scene_layout
   use error_report, only: error_t
   use keyword_reader, only: keyword_deck_t
   use scene_util, only: itoa, where_text
+  use scene_unsupported, only: unsupported_hint
   implicit none
   private
 
@@ -100,8 +101,12 @@ contains
          kind = keyword_kind(blk%name)
          select case (kind)
          case (kw_unknown)
-            call blk%fail('unknown keyword *' // blk%name // &
-                 '; expected a keyword listed in docs/keywords.md', err)
+            if (len(unsupported_hint(blk%name)) > 0) then
+               call blk%fail('*' // blk%name // ' is not simulated by bulkflow; ' // unsupported_hint(blk%name), err)
+            else
+               call blk%fail('unknown keyword *' // blk%name // &
+                    '; expected a keyword listed in docs/keywords.md', err)
+            end if
             return
          case (kw_step)
             if (step > 0) then

@@ -5,9 +5,10 @@
 !> Field output: *NODE OUTPUT U, V, A, RF and *ELEMENT OUTPUT S, LE, PE, PEEQ, SDV, FV,
 !> STATUS. History output: *ENERGY OUTPUT (all energies) and *NODE OUTPUT, NSET=... with
 !> components RF1.., U1.., V1.., A1.. (or RF, U, V, A for all components). Frequencies:
-!> NUMBER INTERVAL= or TIME INTERVAL=; defaults 20 intervals (field) and 200 (history).
-!> VARIABLE=PRESELECT asks for U, V, A, RF, S, LE, PE, PEEQ, STATUS (field) or the
-!> energies (history).
+!> NUMBER INTERVAL=, TIME INTERVAL= or FREQUENCY= (every n increments, Abaqus's meaning);
+!> defaults 20 intervals (field) and 200 (history). VARIABLE=PRESELECT asks for U, V, A,
+!> RF, S, LE, PE, PEEQ, STATUS (field) or the energies (history); VARIABLE=ALL for every
+!> field variable we have (adds SDV) or the energies.
 module scene_outputs
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
@@ -33,6 +34,7 @@ module scene_outputs
      logical :: current_is_field = .false.
      integer :: current_number = 0
      real(dp) :: current_time = 0
+     integer :: current_frequency = 0
   end type output_state_t
 
 contains
@@ -55,11 +57,11 @@ contains
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: op, variable
     real(dp) :: t
-    integer :: n
+    integer :: n, frequency
     type(field_output_t) :: f
 
     call blk%check_params([character(len=15) :: 'FIELD', 'HISTORY', 'NUMBER INTERVAL', 'TIME INTERVAL', &
-         'OP', 'VARIABLE', 'TIME MARKS'], err)
+         'OP', 'VARIABLE', 'TIME MARKS', 'FREQUENCY', 'TIME POINTS'], err)
     if (.not. err%raised) call time_marks(blk, err)
     if (err%raised) return
     if (blk%has_param('FIELD') .eqv. blk%has_param('HISTORY')) then
@@ -67,14 +69,21 @@ contains
             '*OUTPUT, HISTORY', err)
        return
     end if
-    if (blk%has_param('NUMBER INTERVAL') .and. blk%has_param('TIME INTERVAL')) then
-       call blk%fail('*OUTPUT with both NUMBER INTERVAL and TIME INTERVAL; expected one of them', err)
+    if (blk%has_param('TIME POINTS')) then
+       call blk%fail('*OUTPUT, TIME POINTS= (output at listed times) is not supported; expected ' // &
+            'NUMBER INTERVAL=n, TIME INTERVAL=t or FREQUENCY=n', err)
+       return
+    end if
+    if (count([blk%has_param('NUMBER INTERVAL'), blk%has_param('TIME INTERVAL'), blk%has_param('FREQUENCY')]) > 1) then
+       call blk%fail('*OUTPUT with more than one of NUMBER INTERVAL, TIME INTERVAL and FREQUENCY; ' // &
+            'expected one of them', err)
        return
     end if
     call blk%get_string('OP', op, err, default='ADD', choices=[character(len=3) :: 'ADD', 'NEW'])
     if (.not. err%raised) call blk%get_string('VARIABLE', variable, err, default='', &
-         choices=[character(len=9) :: 'PRESELECT'])
+         choices=[character(len=9) :: 'PRESELECT', 'ALL'])
     if (.not. err%raised) call blk%get_integer('NUMBER INTERVAL', n, err, default=0, minimum=1)
+    if (.not. err%raised) call blk%get_integer('FREQUENCY', frequency, err, default=0, minimum=1)
     if (.not. err%raised) call get_real_param(blk, 'TIME INTERVAL', t, err, default=0.0_dp)
     if (err%raised) return
     if (blk%has_param('TIME INTERVAL') .and. .not. (t > 0)) then
@@ -83,27 +92,32 @@ contains
     end if
     call expect_lines(blk, 0, 0, 'no data lines (variables go on *NODE OUTPUT, ...)', err)
     if (err%raised) return
-    if (n_options == 0 .and. variable /= 'PRESELECT') then
+    if (n_options == 0 .and. variable == '') then
        call blk%fail('*OUTPUT requests nothing; expected *NODE OUTPUT, *ELEMENT OUTPUT or ' // &
             '*ENERGY OUTPUT after it, or VARIABLE=PRESELECT', err)
        return
     end if
     os%current_is_field = blk%has_param('FIELD')
-    if (n == 0 .and. .not. (t > 0)) n = merge(default_field_intervals, default_history_intervals, &
-         os%current_is_field)
+    if (n == 0 .and. .not. (t > 0) .and. frequency == 0) n = merge(default_field_intervals, &
+         default_history_intervals, os%current_is_field)
     os%current_number = n
     os%current_time = t
+    os%current_frequency = frequency
     if (op == 'NEW') call drop_inherited(os, os%current_is_field)
     if (os%current_is_field) then
        f%number_interval = n
        f%time_interval = t
+       f%frequency = frequency
        allocate (f%node_variables(0), f%element_variables(0))
        if (variable == 'PRESELECT') then
           f%node_variables = [character(len=8) :: 'U', 'V', 'A', 'RF']
           f%element_variables = [character(len=8) :: 'S', 'LE', 'PE', 'PEEQ', 'STATUS']
+       else if (variable == 'ALL') then
+          f%node_variables = [character(len=8) :: 'U', 'V', 'A', 'RF']
+          f%element_variables = [character(len=8) :: 'S', 'LE', 'PE', 'PEEQ', 'SDV', 'STATUS']
        end if
        call push_field(os, f)
-    else if (variable == 'PRESELECT') then
+    else if (variable /= '') then
        call push_history(os, new_history(os, 0, .true.))
     end if
   end subroutine read_output
@@ -169,6 +183,7 @@ contains
 
     h%number_interval = os%current_number
     h%time_interval = os%current_time
+    h%frequency = os%current_frequency
     h%nset = nset
     h%energies = energies
     allocate (h%node_variables(0))

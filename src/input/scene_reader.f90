@@ -3,12 +3,14 @@
 !>
 !> Everything is checked here, before the first increment; the first problem found ends
 !> the reading with `file:line: what is wrong; expected ...` in `err`. The passes:
-!> keywords and their places (scene_layout), mesh, sets, materials, sections, amplitudes,
+!> parts and instances flattened (scene_assembly), keywords and their places (scene_layout), mesh, sets, materials, sections, amplitudes,
 !> interactions, surfaces and rigid bodies, initial conditions, steps.
 module scene_reader
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, read_keyword_file
   use scene_digest, only: digest_deck
+  use scene_assembly, only: flatten_assembly
+  use scene_idioms, only: rewrite_idioms
   use model, only: model_t
   use scene_layout, only: scene_layout_t, scan_layout
   use scene_mesh, only: mesh_sources_t, build_mesh
@@ -55,6 +57,12 @@ contains
        return
     end if
     call digest_deck(deck, model%digest)
+    ! Parts and instances become the flat deck they mean; a flat deck is left as it is.
+    call flatten_assembly(deck, err)
+    if (err%raised) return
+    ! Print requests dropped (noted), model-level *RESTART and general contact restated.
+    call rewrite_idioms(deck, model%notes, err)
+    if (err%raised) return
     call scan_layout(deck, layout, err)
     if (err%raised) return
     call read_heading(deck, model, err)
@@ -74,6 +82,7 @@ contains
        call build_mpm(deck, layout, grid_block, model, err)
        if (err%raised) return
        call build_steps(deck, layout, model, err)
+       if (.not. err%raised) call refuse_frequency(deck, err)
        return
     end if
     call build_mesh(deck, layout, model, sources, err)
@@ -98,6 +107,20 @@ contains
     if (err%raised) return
     call build_steps(deck, layout, model, err)
   end subroutine read_scene
+
+  !> The MPM run writes output by time only.
+  subroutine refuse_frequency(deck, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(error_t), intent(inout) :: err
+    integer :: i
+
+    do i = 1, deck%n_blocks
+       if (deck%blocks(i)%name /= 'OUTPUT' .or. .not. deck%blocks(i)%has_param('FREQUENCY')) cycle
+       call deck%blocks(i)%fail('*OUTPUT, FREQUENCY= in a material-point scene; expected NUMBER INTERVAL=n ' // &
+            'or TIME INTERVAL=t (the MPM run writes output by time)', err)
+       return
+    end do
+  end subroutine refuse_frequency
 
   !> *HEADING: its first data line is the title (one *HEADING at most).
   subroutine read_heading(deck, model, err)

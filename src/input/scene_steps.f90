@@ -229,12 +229,19 @@ contains
     end if
   end subroutine read_step
 
-  !> Abaqus's NLGEOM: our solver is always geometrically nonlinear.
+  !> Abaqus's NLGEOM: our solver is always geometrically nonlinear. NLGEOM alone means YES
+  !> (Abaqus's spelling as a flag); NLGEOM=NO is refused.
   subroutine check_nlgeom(blk, err)
     type(keyword_block_t), intent(in) :: blk
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: nlgeom
+    integer :: i
 
+    if (allocated(blk%params)) then
+       do i = 1, size(blk%params)
+          if (blk%params(i)%name == 'NLGEOM' .and. .not. blk%params(i)%has_value) return
+       end do
+    end if
     call blk%get_string('NLGEOM', nlgeom, err, default='YES', choices=[character(len=3) :: 'YES'])
   end subroutine check_nlgeom
 

@@ -17,7 +17,7 @@ module scene_util
   public :: itoa, rtoa, where_text, keyword_text
   public :: get_real, get_int, get_real_param, field_blank, field_name, last_field
   public :: expect_fields, expect_lines
-  public :: append_int, sort_permutation, sort_unique, check_name
+  public :: append_int, sort_permutation, sort_unique, check_name, push_block
 
   !> Largest magnitude accepted for any real in a scene (far above any physical value,
   !> far below overflow, so squares and products of two inputs stay finite).
@@ -118,6 +118,23 @@ contains
     end if
     name = upper_case(t)
   end function field_name
+
+  !> Append a copy of `blk` to out(1:n), growing `out` by doubling.
+  subroutine push_block(out, n, blk)
+    type(keyword_block_t), allocatable, intent(inout) :: out(:)
+    integer, intent(inout) :: n
+    type(keyword_block_t), intent(in) :: blk
+    type(keyword_block_t), allocatable :: tmp(:)
+
+    if (.not. allocated(out)) allocate (out(8))
+    if (n == size(out)) then
+       allocate (tmp(2 * n + 8))
+       tmp(1:n) = out(1:n)
+       call move_alloc(tmp, out)
+    end if
+    n = n + 1
+    out(n) = blk
+  end subroutine push_block
 
   !> Position of the last non-blank field (a trailing ", ," adds nothing).
   pure integer function last_field(dl)

@@ -56,6 +56,7 @@ module model
      type(mpm_scene_t) :: mpm                 !< material-point part (active with *MPM GRID)
      type(scene_digest_t) :: digest           !< the deck's lines, hashed (restarts check it)
      character(len=1024), allocatable :: warnings(:)  !< "file:line: what" found while building
+     character(len=512), allocatable :: notes(:)  !< `file:line: note: ...` for keywords accepted but not acted on
   end type model_t
 
   public :: name_length

@@ -47,10 +47,11 @@ module model_steps
   end type contact_pair_t
 
   !> Field output (*OUTPUT, FIELD + *NODE OUTPUT / *ELEMENT OUTPUT): at `number_interval`
-  !> equal intervals of the step or every `time_interval` (one of them > 0).
+  !> equal intervals of the step, every `time_interval` or every `frequency` increments (one > 0).
   type, public :: field_output_t
      integer :: number_interval = 0
      real(dp) :: time_interval = 0
+     integer :: frequency = 0                 !< FREQUENCY=n: every n increments of the step (and its end)
      character(len=8), allocatable :: node_variables(:)     !< U, V, A, RF
      character(len=8), allocatable :: element_variables(:)  !< S, LE, PE, PEEQ, SDV, FV, STATUS
   end type field_output_t
@@ -59,6 +60,7 @@ module model_steps
   type, public :: history_output_t
      real(dp) :: time_interval = 0            !< 0: every increment
      integer :: number_interval = 0
+     integer :: frequency = 0                 !< FREQUENCY=n: every n increments of the step (and its end)
      logical :: energies = .false.            !< ALLKE ALLIE ALLVD ALLFD ALLWK ALLAE ETOTAL
      integer :: nset = 0                      !< node set for per-set sums, 0: none
      character(len=8), allocatable :: node_variables(:)     !< e.g. RF1, RF2, U2, V2 summed/averaged over nset

@@ -1,0 +1,87 @@
+#!/usr/bin/env python3
+"""Show that a change did not change results: two bulkflow binaries run the same decks, and the
+exit status, the history CSV (bytes) and every dataset and attribute of the .h5 (exact, h5py)
+must be identical.
+
+    python3 scripts/compare_binaries.py OLD_BIN NEW_BIN DECK... [--stop-after 300] [--workdir DIR]
+
+OLD_BIN is typically main's build (build it from a clean checkout of main), NEW_BIN the branch's.
+Prints one line per deck and exits 1 if any deck differs.
+"""
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+
+def h5_differences(a: Path, b: Path) -> list[str]:
+    """Names of the datasets/attributes that differ (floats compared by their bytes)."""
+    out: list[str] = []
+
+    def same(x, y) -> bool:
+        x, y = np.asarray(x), np.asarray(y)
+        if x.shape != y.shape or x.dtype != y.dtype:
+            return False
+        return x.tobytes() == y.tobytes() if np.issubdtype(x.dtype, np.floating) else np.array_equal(x, y)
+
+    def walk(g1, g2, path: str) -> None:
+        for k, v in g1.attrs.items():
+            if k not in g2.attrs or not same(v, g2.attrs[k]):
+                out.append(f'attribute {path}@{k}')
+        if set(g1.keys()) != set(g2.keys()):
+            out.append(f'members of {path or "/"}')
+        for k in set(g1.keys()) & set(g2.keys()):
+            if isinstance(g1[k], h5py.Group):
+                walk(g1[k], g2[k], f'{path}/{k}')
+            elif not same(g1[k][()], g2[k][()]):
+                out.append(f'dataset {path}/{k}')
+
+    with h5py.File(a, 'r') as f1, h5py.File(b, 'r') as f2:
+        walk(f1, f2, '')
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    ap.add_argument('old')
+    ap.add_argument('new')
+    ap.add_argument('decks', nargs='+', type=Path)
+    ap.add_argument('--stop-after', type=int, default=300, help='increments per run (default 300)')
+    ap.add_argument('--workdir', type=Path, help='keep the outputs here (default: a scratch directory)')
+    a = ap.parse_args(argv)
+    with tempfile.TemporaryDirectory(prefix='bulkflow_compare_') as tmp:
+        work = a.workdir or Path(tmp)
+        work.mkdir(parents=True, exist_ok=True)
+        differ = 0
+        for deck in a.decks:
+            runs = []
+            for tag, exe in (('old', a.old), ('new', a.new)):
+                base = work / f'{deck.stem}_{tag}'
+                p = subprocess.run([exe, str(deck.resolve()), '--output', str(base), '--stop-after',
+                                    str(a.stop_after), '--quiet'], capture_output=True, text=True, timeout=600)
+                runs.append((base, p.returncode))
+            (b0, r0), (b1, r1) = runs
+            h0, h1 = Path(f'{b0}_history.csv'), Path(f'{b1}_history.csv')
+            same_history = h0.exists() == h1.exists() and (not h0.exists() or h0.read_bytes() == h1.read_bytes())
+            f0, f1 = Path(f'{b0}.h5'), Path(f'{b1}.h5')
+            if f0.exists() and f1.exists():
+                diffs = h5_differences(f0, f1)
+            else:
+                diffs = [] if f0.exists() == f1.exists() else ['.h5 written by one binary only']
+            ok = r0 == r1 and same_history and not diffs
+            differ += not ok
+            print(f'{"same" if ok else "DIFFERS"}  {deck}: exit {r0}/{r1}, history '
+                  f'{"identical" if same_history else "differs"}, .h5 '
+                  f'{"identical" if not diffs else ", ".join(diffs[:4])}')
+    print('all identical' if not differ else f'{differ} of {len(a.decks)} decks differ')
+    return 1 if differ else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
