@@ -33,6 +33,7 @@ module keyword_reader
 
   public :: keyword_param_t, data_line_t, keyword_block_t, keyword_deck_t
   public :: read_keyword_file, read_keyword_string
+  public :: set_field, keep_fields
   public :: upper_case, is_real_text, is_integer_text, is_integer_syntax
 
   !> Deepest *INCLUDE nesting accepted; deeper means a circular include.
@@ -117,6 +118,63 @@ module keyword_reader
 contains
 
   ! ------------------------------------------------------------------ data lines
+
+  !> Rewrite field `i` of a data line (the deck layer that maps parts and instances onto the flat
+  !> model, and general contact, rewrite lines they were given). The line then owns a small text
+  !> of its own ("f1, f2, ..."), so the file's buffer, shared by every other line, is never
+  !> written; a field beyond the last one extends the line with blank fields.
+  subroutine set_field(dl, i, value)
+    type(data_line_t), intent(inout) :: dl
+    integer, intent(in) :: i
+    character(len=*), intent(in) :: value
+    integer :: n
+
+    n = max(dl%nf, i)
+    call rebuild_line(dl, n, i, value)
+  end subroutine set_field
+
+  !> Drop every field after the first `n` (fewer fields only).
+  subroutine keep_fields(dl, n)
+    type(data_line_t), intent(inout) :: dl
+    integer, intent(in) :: n
+
+    if (n >= dl%nf) return
+    call rebuild_line(dl, max(n, 0), 0, '')
+  end subroutine keep_fields
+
+  !> The line made again from its first `n` fields, field `i` (if 1..n) replaced by `value`.
+  subroutine rebuild_line(dl, n, i, value)
+    type(data_line_t), intent(inout) :: dl
+    integer, intent(in) :: n, i
+    character(len=*), intent(in) :: value
+    type(source_t), pointer :: own
+    character(len=:), allocatable :: text, f
+    integer, allocatable :: bounds(:)
+    integer :: k
+
+    allocate (bounds(2 * n))
+    text = ''
+    do k = 1, n
+       if (k == i) then
+          f = value
+       else
+          f = dl%field(k)
+       end if
+       if (k > 1) text = text // ', '
+       bounds(2 * k - 1) = len(text) + 1
+       text = text // f
+       bounds(2 * k) = len(text)
+    end do
+    allocate (own)
+    if (associated(dl%file)) own%name = dl%file
+    own%text = text
+    call move_alloc(bounds, own%bounds)
+    own%n_bounds = 2 * n
+    dl%src => own
+    dl%text => own%text
+    dl%first = 0
+    dl%nf = n
+  end subroutine rebuild_line
 
   pure integer function data_n_fields(self)
     class(data_line_t), intent(in) :: self

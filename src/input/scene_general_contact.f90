@@ -7,7 +7,7 @@
 !> element surfaces, exclusions and the other general-contact options.
 module scene_general_contact
   use error_report, only: error_t, raise_error
-  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, upper_case
+  use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, upper_case, set_field, keep_fields
   use scene_util, only: field_name, field_blank, push_block
   implicit none
   private
@@ -255,10 +255,8 @@ contains
     pair%n_lines = 1
     allocate (pair%lines(1))
     pair%lines(1) = dl
-    deallocate (pair%lines(1)%fields)
-    allocate (pair%lines(1)%fields(2))
-    pair%lines(1)%fields(1)%s = '"' // a // '"'
-    pair%lines(1)%fields(2)%s = '"' // b // '"'
-    pair%lines(1)%text = a // ', ' // b
+    call keep_fields(pair%lines(1), 0)
+    call set_field(pair%lines(1), 1, '"' // a // '"')
+    call set_field(pair%lines(1), 2, '"' // b // '"')
   end function contact_pair
 end module scene_general_contact

@@ -10,7 +10,8 @@
 module scene_instance_map
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use keyword_reader, only: keyword_block_t, data_line_t, upper_case, is_integer_text, is_real_text
+  use keyword_reader, only: keyword_block_t, data_line_t, upper_case, is_integer_text, is_real_text, &
+    set_field
   use scene_util, only: itoa, field_name, field_blank
   implicit none
   private
@@ -140,6 +141,7 @@ contains
   subroutine strip_assembly_prefix(blk, asm)
     type(keyword_block_t), intent(inout) :: blk
     type(instance_t), intent(in) :: asm
+    character(len=:), allocatable :: f
     integer :: i, il, n
 
     if (.not. allocated(asm%prefix)) return
@@ -154,11 +156,10 @@ contains
     end if
     do il = 1, blk%n_lines
        do i = 1, blk%lines(il)%n_fields()
-          associate (f => blk%lines(il)%fields(i)%s)
-            if (len(f) > n) then
-               if (upper_case(f(1:n)) == asm%prefix) blk%lines(il)%fields(i)%s = f(n + 1:)
-            end if
-          end associate
+          f = blk%lines(il)%field(i)
+          if (len(f) > n) then
+             if (upper_case(f(1:n)) == asm%prefix) call set_field(blk%lines(il), i, f(n + 1:))
+          end if
        end do
     end do
   end subroutine strip_assembly_prefix
@@ -289,9 +290,8 @@ contains
        return
     end if
     do i = 1, nc
-       dl%fields(i + 1)%s = real_text(y(i))
+       call set_field(dl, i + 1, real_text(y(i)))
     end do
-    call refresh_text(dl)
   end subroutine rewrite_node_line
 
   subroutine rewrite_element_line(dl, owner, err)
@@ -305,7 +305,6 @@ contains
        if (err%raised) return
        if (.not. field_blank(dl, i)) call offset_field(dl, i, owner%node_offset, err)
     end do
-    call refresh_text(dl)
   end subroutine rewrite_element_line
 
   !> *NSET / *ELSET data: numbers offset (GENERATE: first and last, not the increment),
@@ -331,15 +330,13 @@ contains
        else
           call split_label(instances, n, text, k, label)
           if (k /= 0) then
-             dl%fields(i)%s = itoa(label + merge(instances(k)%node_offset, instances(k)%elem_offset, &
-                  blk%name == 'NSET'))
+             call set_field(dl, i, itoa(label + merge(instances(k)%node_offset, instances(k)%elem_offset, blk%name == 'NSET')))
           else if (level == level_part .or. by_instance) then
-             dl%fields(i)%s = qualified(owner, text)
+             call set_field(dl, i, qualified(owner, text))
           end if
        end if
        if (err%raised) return
     end do
-    call refresh_text(dl)
   end subroutine rewrite_set_line
 
   !> A label field (node or element number, `inst.n`, or a set name).
@@ -365,12 +362,11 @@ contains
     else
        call split_label(instances, n, text, k, label)
        if (k /= 0) then
-          dl%fields(i)%s = itoa(label + merge(instances(k)%node_offset, instances(k)%elem_offset, kind == 'N'))
+          call set_field(dl, i, itoa(label + merge(instances(k)%node_offset, instances(k)%elem_offset, kind == 'N')))
        else if (level == level_part .or. by_instance) then
-          dl%fields(i)%s = qualified(owner, field_name(dl, i))
+          call set_field(dl, i, qualified(owner, field_name(dl, i)))
        end if
     end if
-    call refresh_text(dl)
   end subroutine rewrite_label_field
 
   !> *SURFACE, TYPE=SEGMENTS lines (START / LINE / CIRCL): the points placed.
@@ -397,10 +393,9 @@ contains
                'out of the x-y plane; expected a translation in x, y and rotations about the z axis', err)
           return
        end if
-       dl%fields(i)%s = real_text(y(1))
-       dl%fields(i + 1)%s = real_text(y(2))
+       call set_field(dl, i, real_text(y(1)))
+       call set_field(dl, i + 1, real_text(y(2)))
     end do
-    call refresh_text(dl)
   end subroutine rewrite_segment_line
 
   !> Field i (an integer) + offset.
@@ -418,20 +413,8 @@ contains
             ' exceeds the largest number bulkflow reads (' // itoa(huge(label)) // '); expected smaller labels', err)
        return
     end if
-    dl%fields(i)%s = itoa(label + offset)
+    call set_field(dl, i, itoa(label + offset))
   end subroutine offset_field
-
-  !> The line's text made from its (rewritten) fields.
-  subroutine refresh_text(dl)
-    type(data_line_t), intent(inout) :: dl
-    integer :: i
-
-    dl%text = ''
-    do i = 1, dl%n_fields()
-       if (i > 1) dl%text = dl%text // ', '
-       dl%text = dl%text // dl%field(i)
-    end do
-  end subroutine refresh_text
 
   !> A real that reads back to the same value.
   pure function real_text(x) result(t)
