@@ -9,7 +9,7 @@ module driver_setup
   use parallel_assembly, only: assemble_element_vectors, block_assembly_t, block_assembly_init, &
        assembly_start, assembly_add_block, assembly_finish
   use driver_solver, only: solver_t, element_block_t, build_blocks
-  use driver_vumat_call, only: packaging_modulus
+  use driver_vumat_call, only: checked_packaging_modulus
   use fem_cpe4r, only: cpe4r_geometry, cpe4r_internal_force
   use fem_c3d8r, only: c3d8r_geometry, c3d8r_internal_force
   use fem_corotation, only: identity_rotation, stored_to_global
@@ -61,7 +61,7 @@ contains
     do ib = 1, solver%n_blocks
        k = solver%blocks(ib)%material
        if (.not. known(k)) then
-          moduli(k) = packaging_modulus(m%materials(k), solver%ncomp, solver%nshr)
+          moduli(k) = checked_packaging_modulus(m%materials(k), solver%ncomp, solver%nshr, m%input_file)
           known(k) = .true.
        end if
     end do
@@ -194,7 +194,7 @@ contains
       blk%e_int = 0
       blk%e_inel = 0
       blk%wave_modulus = modulus
-      blk%vumat_needs_kinematics = model_from_name(mat%vumat_name) == model_unknown
+      blk%vumat_needs_kinematics = mat%user_code .or. model_from_name(mat%vumat_name) == model_unknown
     end associate
   end subroutine setup_block
 

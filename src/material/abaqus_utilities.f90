@@ -1,9 +1,12 @@
-! Abaqus/Explicit utility routines that user subroutines call (vgetvrm, xplb_abqerr,
-! xplb_exit), provided by the bulkflow host with Abaqus's argument lists. They are external
-! procedures on purpose: user code calls them without an interface, exactly as in Abaqus.
+! Abaqus/Explicit utility routines that user subroutines call (vgetvrm, vgetnumcpus, vgetrank,
+! vgetjobname, vgetoutdir, xplb_abqerr, xplb_exit), provided by the bulkflow host with
+! Abaqus's argument lists (Abaqus User Subroutines Reference Guide, "Utility routines for
+! Abaqus/Explicit"). They are external procedures on purpose: user code calls them without an
+! interface, exactly as in Abaqus. The executables export them, so a user library loaded
+! with --user finds them (src/material/user_library.f90).
 
 !> Start-of-increment values of an output variable for the current block.
-!> Supported keys: 'S' (stress), 'LE' (logarithmic strain); others return jStatus = 1.
+!> Keys: S, LE, SDV, TEMP, and PE, PEEQ for our plastic models; others return jStatus = 1.
 subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
   use material_kinds, only: dp
   use abaqus_host, only: host_get_variable
@@ -81,3 +84,39 @@ subroutine xplb_exit()
   implicit none
   call host_exit(3)
 end subroutine xplb_exit
+
+!> Number of processes of the run (Abaqus: CPUs of the analysis).
+subroutine vgetnumcpus(numCpus)
+  use abaqus_host, only: host_ranks
+  implicit none
+  integer, intent(out) :: numCpus
+  numCpus = host_ranks()
+end subroutine vgetnumcpus
+
+!> This process's number, 0 for the first (MPI rank).
+subroutine vgetrank(kProcessNum)
+  use abaqus_host, only: host_rank
+  implicit none
+  integer, intent(out) :: kProcessNum
+  kProcessNum = host_rank()
+end subroutine vgetrank
+
+!> The job name: bulkflow's output base name (--output, else the scene's name).
+subroutine vgetjobname(jobName, jobNameLen)
+  use abaqus_host, only: host_job_name
+  implicit none
+  character(len=*), intent(out) :: jobName
+  integer, intent(out) :: jobNameLen
+  jobName = host_job_name()
+  jobNameLen = min(len(jobName), len(host_job_name()))
+end subroutine vgetjobname
+
+!> The folder the outputs are written to.
+subroutine vgetoutdir(outDir, outDirLen)
+  use abaqus_host, only: host_output_dir
+  implicit none
+  character(len=*), intent(out) :: outDir
+  integer, intent(out) :: outDirLen
+  outDir = host_output_dir()
+  outDirLen = min(len(outDir), len(host_output_dir()))
+end subroutine vgetoutdir
