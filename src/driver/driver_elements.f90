@@ -356,6 +356,9 @@ contains
        end if
        call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
        call centroids(nb, nd, ne, w%xe_old, w%du, w%vumat%coord)
+       ! constant in time: *INITIAL CONDITIONS, TYPE=TEMPERATURE
+       w%vumat%temp(1:nb) = blk%temp
+       w%vumat%temp_new(1:nb) = blk%temp
     end if
 
     ! PE (only when written): Δε^p = Δε − C⁻¹(σ_new − σ_old); the σ_old part before the call.

@@ -107,13 +107,20 @@ contains
        end do
     end if
     if (allocated(m%initial_fields)) then
-       ! Element value = mean of its nodes' values (nodes without a value count as 0).
+       ! Element value = mean of its nodes' values (nodes without a value count as 0). Our models
+       ! read field 1 with a user field only; a user's VUMAT gets every field and the temperature.
        do ib = 1, solver%n_blocks
-          associate (blk => solver%blocks(ib))
-            if (blk%nfieldv < 1 .or. .not. m%materials(blk%material)%user_field) cycle
+          associate (blk => solver%blocks(ib), mat => m%materials(solver%blocks(ib)%material))
             do e = 1, blk%count
                g = part%elem_global(blk%first + e - 1)
-               blk%field(e, 1) = mean_initial_field(m, g)
+               if (mat%user_code) then
+                  blk%temp(e) = mean_initial_field(m, g, 0)
+                  do k = 1, mat%nfieldv
+                     blk%field(e, k) = mean_initial_field(m, g, k)
+                  end do
+               else if (blk%nfieldv >= 1 .and. mat%user_field) then
+                  blk%field(e, 1) = mean_initial_field(m, g, 1)
+               end if
             end do
           end associate
        end do
@@ -145,6 +152,8 @@ contains
       end if
       allocate(blk%stress(nb, solver%ncomp))
       allocate(blk%state(nb, blk%nstatev), blk%field(nb, blk%nfieldv), blk%e_int(nb), blk%e_inel(nb))
+      allocate(blk%temp(nb))
+      blk%temp = 0
       ! Hourglass forces of t_n for the ALLAE work: CPE4R keeps the generalised force Q (nb, 2, 1)
       ! of its one mode (cpe4r_hourglass_update), C3D8R the nodal forces (nb, 3, 8).
       if (m%mesh%element_type == element_cpe4r) then
@@ -259,16 +268,17 @@ contains
     e = 1
   end subroutine locate
 
-  real(dp) function mean_initial_field(m, g)
+  !> Field `variable` (0: the temperature) of global element g: the mean of its nodes' values.
+  real(dp) function mean_initial_field(m, g, variable)
     type(model_t), intent(in) :: m
-    integer, intent(in) :: g
+    integer, intent(in) :: g, variable
     integer :: a, j, i
     real(dp) :: total
 
     total = 0
     do a = 1, m%mesh%nen
        do j = 1, size(m%initial_fields)
-          if (m%initial_fields(j)%variable /= 1) cycle
+          if (m%initial_fields(j)%variable /= variable) cycle
           do i = 1, size(m%initial_fields(j)%nodes)
              if (m%initial_fields(j)%nodes(i) == m%mesh%conn(a, g)) total = total + m%initial_fields(j)%value
           end do

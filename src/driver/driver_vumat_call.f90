@@ -25,6 +25,7 @@ module driver_vumat_call
 
   !> Arguments of a vumat call that the solver does not keep between increments.
   type, public :: vumat_work_t
+     character(len=8) :: point_kind = 'element'       !< what elem_number counts (messages)
      integer, allocatable :: jblock(:)
      real(dp), allocatable :: coord(:, :), temp(:), temp_new(:), stretch_old(:, :), stretch_new(:, :)
      real(dp), allocatable :: defgrad_old(:, :), defgrad_new(:, :), field_new(:, :)
@@ -190,6 +191,7 @@ contains
             e_int(i0:i1), e_inel(i0:i1), w%temp_new(i0:i1), stretch_new(i0:i1, :), defgrad_new(i0:i1, :), &
             w%field_new(1:n, 1:nf), w%stress_new(1:n, :), w%state_new(1:n, 1:ns), w%e_int_new(1:n), &
             w%e_inel_new(1:n))
+       call check_finite(mat, n, ncomp, elem_number(i0:i1), total_time, w%stress_new, w%point_kind)
        stress(i0:i1, :) = w%stress_new(1:n, :)
        state(i0:i1, 1:ns) = w%state_new(1:n, 1:ns)
        field(i0:i1, 1:nf) = w%field_new(1:n, 1:nf)
@@ -197,6 +199,28 @@ contains
        e_inel(i0:i1) = w%e_inel_new(1:n)
     end do
   end subroutine call_user_material
+
+  !> Stop with the material, the element or particle and the time when a user's VUMAT returned
+  !> a stress that is not a finite number (it would spread through the mesh as NaN).
+  subroutine check_finite(mat, n, ncomp, numbers, total_time, stress_new, point_kind)
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: n, ncomp, numbers(n)
+    real(dp), intent(in) :: total_time, stress_new(:, :)
+    character(len=*), intent(in) :: point_kind
+    character(len=160) :: text
+    integer :: k, j
+
+    do j = 1, ncomp
+       do k = 1, n
+          if (ieee_is_finite(stress_new(k, j))) cycle
+          write (text, '(a,i0,a,i0,a,es13.6)') trim(point_kind) // ' ', numbers(k), ': stress component ', j, &
+               ' is not a finite number at total time ', total_time
+          call raise_error(trim(mat%source), 0, 'the user VUMAT of material ' // trim(mat%name) // &
+               ' returned a stress that is not a number: ' // trim(text) // '; expected finite stressNew')
+       end do
+    end do
+  end subroutine check_finite
 
   !> swap_or_copy for the (nb) energy arrays.
   subroutine swap_or_copy_1d(block, work, nb)

@@ -999,6 +999,7 @@ contains
     integer, intent(in) :: rows
 
     call vumat_work_init(w, rows, st%nc, st%nshr, st%work_statev, st%work_fieldv)
+    w%point_kind = 'particle'
     w%stretch_old = 0
     w%stretch_old(:, 1:3) = 1
     w%defgrad_old = 0
