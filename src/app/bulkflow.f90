@@ -5,7 +5,9 @@
 !>
 !> --user FILE: the user's VUMAT/VUSDFLD file, as Abaqus's user=FILE: compiled into a cached
 !> shared library (rank 0 compiles, the others wait) and loaded on every rank; every
-!> *USER MATERIAL then calls the user's vumat (docs/user_subroutines.md).
+!> *USER MATERIAL then calls the user's vumat (docs/user_subroutines.md). --user-linked: the
+!> same, with the vumat linked into this executable (a CMake BULKFLOW_USER_SUBROUTINE build, or
+!> ours: what scripts/bench_user.py compares run-time loading with).
 !>
 !> The scene is read and checked completely before the first increment; any problem stops with
 !> `file:line: message` and exit status 2. Outputs: BASE.h5 + BASE.xmf (field frames),
@@ -22,6 +24,7 @@ program bulkflow
   use mpm_run, only: mpm_run_scene
   use abaqus_host, only: host_set_exit_handler, host_set_job
   use user_library, only: user_library_prepare, user_library_open
+  use material_entry, only: use_linked_entries
   use parallel_abort, only: abort_all, abort_all_status
   use output_collective, only: stop_agreed_error
   implicit none
@@ -30,7 +33,7 @@ program bulkflow
   type(run_options_t) :: opts
   character(len=:), allocatable :: scene, user_file
   character(len=1024), allocatable :: user_includes(:)
-  logical :: check_only
+  logical :: check_only, user_linked
   integer :: rank, nranks
 
   call MPI_Init()
@@ -44,8 +47,9 @@ program bulkflow
   call parse_arguments(scene, opts, check_only)
   call host_set_job(base_name(opts%output_base), folder_of(opts%output_base), rank, nranks)
   if (len(user_file) > 0) call load_user_file()
+  if (user_linked) call use_linked_entries()
 
-  call read_scene(scene, m, err, user_subroutine=len(user_file) > 0)
+  call read_scene(scene, m, err, user_subroutine=len(user_file) > 0 .or. user_linked)
   if (err%raised) call input_error_exit(err)
   if (check_only) then
      if (rank == 0 .and. m%mpm%active) then
@@ -77,6 +81,7 @@ contains
     i = 1
     scene = ''
     user_file = ''
+    user_linked = .false.
     allocate (user_includes(0))
     do while (i <= n)
        call get_command_argument(i, arg)
@@ -87,6 +92,8 @@ contains
           opts%restart = .true.
        case ('--quiet')
           opts%progress = .false.
+       case ('--user-linked')
+          user_linked = .true.
        case ('--output', '--stop-after', '--user', '--user-include')
           if (i == n) call usage('option ' // trim(arg) // ' needs a value')
           call get_command_argument(i + 1, value)
@@ -112,6 +119,7 @@ contains
     end do
     if (len(scene) == 0) call usage('no scene file given')
     if (size(user_includes) > 0 .and. len(user_file) == 0) call usage('--user-include without --user')
+    if (user_linked .and. len(user_file) > 0) call usage('--user and --user-linked together')
     if (.not. allocated(opts%output_base)) then
        slash = index(scene, '/', back=.true.)
        dot = index(scene, '.', back=.true.)
@@ -125,7 +133,7 @@ contains
     if (rank == 0) then
        if (len(problem) > 0) write (error_unit, '(a)') 'bulkflow: error: ' // problem
        write (error_unit, '(a)') 'usage: [mpirun -np N] bulkflow scene.inp [--check] [--output BASE] ' // &
-            '[--restart] [--stop-after N] [--quiet] [--user FILE [--user-include DIR]...]'
+            '[--restart] [--stop-after N] [--quiet] [--user FILE [--user-include DIR]... | --user-linked]'
     end if
     call MPI_Finalize()
     if (len(problem) > 0) error stop 2, quiet=.true.

@@ -2,15 +2,20 @@
 !> Elements, particles and the material-point driver take their entry points here, so the
 !> choice is made in one place (name resolution: docs/user_subroutines.md).
 module material_entry
-  use user_library, only: user_vumat, user_vusdfld
+  use user_library, only: user_vumat, user_vusdfld, user_library_use_linked
   implicit none
   private
 
   external :: vumat, vusdfld
 
-  public :: vumat_entry, vusdfld_entry
+  public :: vumat_entry, vusdfld_entry, use_linked_entries
 
 contains
+
+  !> --user-linked: *USER MATERIALs take the user's path with the vumat/vusdfld linked in.
+  subroutine use_linked_entries()
+    call user_library_use_linked(vumat, vusdfld, 'the linked-in subroutines')
+  end subroutine use_linked_entries
 
   !> `user`: the material is a *USER MATERIAL and a user file is loaded.
   function vumat_entry(user) result(entry)

@@ -25,6 +25,7 @@ module user_library
   procedure(), pointer, public, protected :: user_vumat => null(), user_vusdfld => null()
 
   public :: user_library_prepare, user_library_open, user_library_loaded, user_library_name
+  public :: user_library_use_linked
 
   character(len=:), allocatable :: loaded_name    !< the file given with --user, for messages
 
@@ -146,7 +147,7 @@ contains
        command = "'" // user_compiler // "' -shared -Wl,-Bsymbolic"
        key = content_key(text // user_compiler)
     else
-       command = "'" // user_compiler // "' " // user_flags // ' ' // form // ' -fPIC -shared -Wl,-Bsymbolic'
+       command = "'" // user_compiler // "' " // user_flags // ' ' // form // ' -fPIC -fno-semantic-interposition -shared -Wl,-Bsymbolic'
        command = command // " -I'" // directory_of(source) // "'"
        do k = 1, size(include_dirs)
           command = command // " -I'" // trim(include_dirs(k)) // "'"
@@ -216,6 +217,17 @@ contains
     loaded_name = source
     status = 0
   end subroutine user_library_open
+
+  !> The entry points linked into the executable serve as the user's (--user-linked): the same
+  !> path as a loaded library, without the library; for a build whose vumat is a user's file
+  !> linked in (CMake BULKFLOW_USER_SUBROUTINE), and to measure what run-time loading costs.
+  subroutine user_library_use_linked(umat, usdfld, name)
+    procedure() :: umat, usdfld
+    character(len=*), intent(in) :: name
+    user_vumat => umat
+    user_vusdfld => usdfld
+    loaded_name = name
+  end subroutine user_library_use_linked
 
   !> The address of `name` as compilers spell Fortran names (gfortran and Intel: name_).
   function find_symbol(handle, name) result(address)
