@@ -21,11 +21,20 @@ if(PFUNIT_FOUND AND NOT BULKFLOW_PFUNIT_FALLBACK)
 else()
   set(BULKFLOW_PF_BACKEND "fallback")
   message(STATUS "bulkflow: .pf tests use bulkflow's fallback harness (pFUnit not used)")
+  # The typed generics (one specific per combination pFUnit 4 accepts) are generated.
+  set(_bulkflow_funit_typed "${CMAKE_BINARY_DIR}/funit_generated/funit_assert_typed.f90")
+  add_custom_command(
+    OUTPUT "${_bulkflow_funit_typed}"
+    COMMAND "${Python3_EXECUTABLE}" "${_BULKFLOW_PF_DIR}/funit_generate.py" "${_bulkflow_funit_typed}"
+    DEPENDS "${_BULKFLOW_PF_DIR}/funit_generate.py"
+    COMMENT "Generating the fallback harness's typed assertions"
+    VERBATIM)
   add_library(bulkflow_funit STATIC
     "${_BULKFLOW_PF_DIR}/funit/funit_core.f90"
     "${_BULKFLOW_PF_DIR}/funit/funit_assert_logical.f90"
     "${_BULKFLOW_PF_DIR}/funit/funit_assert_equal.f90"
     "${_BULKFLOW_PF_DIR}/funit/funit_assert_compare.f90"
+    "${_bulkflow_funit_typed}"
     "${_BULKFLOW_PF_DIR}/funit/funit.f90"
     "${_BULKFLOW_PF_DIR}/funit/funit_runner.f90")
   set_target_properties(bulkflow_funit PROPERTIES
@@ -45,8 +54,17 @@ function(bulkflow_add_pf_test pf_file)
     set(arg_TIMEOUT 300)
   endif()
 
+  # A label list given quoted ("unit;mpm") reaches us with its ';' escaped: split it again.
+  string(REPLACE "\\;" ";" arg_LABELS "${arg_LABELS}")
+
   if(BULKFLOW_PF_BACKEND STREQUAL "pfunit")
-    add_pfunit_ctest(${name} TEST_SOURCES "${pf}" LINK_LIBRARIES ${arg_LINK_LIBRARIES})
+    # add_pfunit_ctest writes the generated .F90 beside an absolute TEST_SOURCES path (it takes
+    # such a path to be in the build tree) and into the binary directory for a relative one.
+    file(RELATIVE_PATH pf_relative "${CMAKE_CURRENT_SOURCE_DIR}" "${pf}")
+    if(pf_relative MATCHES "^\\.\\./")
+      message(FATAL_ERROR "bulkflow_add_pf_test(${pf_file}): the .pf file must be in or below ${CMAKE_CURRENT_SOURCE_DIR}")
+    endif()
+    add_pfunit_ctest(${name} TEST_SOURCES "${pf_relative}" LINK_LIBRARIES ${arg_LINK_LIBRARIES})
     # pFUnit's generated wrappers are not ours to keep warning-free.
     target_compile_options(${name} PRIVATE "$<$<COMPILE_LANGUAGE:Fortran>:-Wno-error>")
   else()

@@ -4,9 +4,8 @@
 module funit
   use funit_core, only: SourceLocation, anyExceptions
   use funit_assert_logical, only: assertTrue, assertFalse, assertFail
-  use funit_assert_equal, only: assertEqual, assertRelativelyEqual
-  use funit_assert_compare, only: assertLessThan, assertLessThanOrEqual, assertGreaterThan, &
-    assertGreaterThanOrEqual, assertIsFinite, assertIsNaN
+  use funit_assert_typed, only: assertEqual, assertRelativelyEqual, assertLessThan, &
+    assertLessThanOrEqual, assertGreaterThan, assertGreaterThanOrEqual, assertIsFinite, assertIsNaN
   implicit none
   private
 

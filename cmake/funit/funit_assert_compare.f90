@@ -1,9 +1,8 @@
-!> Ordering and IEEE-class assertions, with pFUnit's argument order:
-!>   assertLessThan(lhs, rhs[, message][, location])            passes when lhs <  rhs
-!>   assertLessThanOrEqual, assertGreaterThan, assertGreaterThanOrEqual   likewise
-!>   assertIsFinite(x[, message][, location]), assertIsNaN(x, ...)   x scalar or rank 1-2 array
-!> Operands are integer or real scalars of any common kind; two integers compare exactly, any
-!> other pair as real(dp). A NaN operand fails every ordering assertion.
+!> The checks behind the ordering assertions (assertLessThan(lhs, rhs) passes when lhs < rhs;
+!> LessThanOrEqual, GreaterThan, GreaterThanOrEqual likewise) and the IEEE-class assertions
+!> (assertIsFinite, assertIsNaN). Their typed generics are generated into funit_assert_typed
+!> by cmake/funit_generate.py. Two integers compare exactly, any other pair as real(dp); a NaN
+!> operand fails every ordering assertion.
 module funit_assert_compare
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite, ieee_status_type, &
     ieee_get_status, ieee_set_status, ieee_set_halting_mode, ieee_usual
@@ -13,48 +12,13 @@ module funit_assert_compare
   implicit none
   private
 
-  public :: assertLessThan, assertLessThanOrEqual, assertGreaterThan, assertGreaterThanOrEqual
-  public :: assertIsFinite, assertIsNaN
+  public :: check_order, check_class
+  public :: order_less, order_less_or_equal, order_greater, order_greater_or_equal
 
-  integer, parameter :: less = 1, less_or_equal = 2, greater = 3, greater_or_equal = 4
-
-  interface assertIsFinite
-    module procedure is_finite_0, is_finite_1, is_finite_2
-  end interface assertIsFinite
-
-  interface assertIsNaN
-    module procedure is_nan_0, is_nan_1, is_nan_2
-  end interface assertIsNaN
+  integer, parameter :: order_less = 1, order_less_or_equal = 2, order_greater = 3, &
+                        order_greater_or_equal = 4
 
 contains
-
-  subroutine assertLessThan(lhs, rhs, message, location)
-    class(*), intent(in) :: lhs, rhs
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_order('assertLessThan', less, flatten(lhs), flatten(rhs), message, location)
-  end subroutine assertLessThan
-
-  subroutine assertLessThanOrEqual(lhs, rhs, message, location)
-    class(*), intent(in) :: lhs, rhs
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_order('assertLessThanOrEqual', less_or_equal, flatten(lhs), flatten(rhs), message, location)
-  end subroutine assertLessThanOrEqual
-
-  subroutine assertGreaterThan(lhs, rhs, message, location)
-    class(*), intent(in) :: lhs, rhs
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_order('assertGreaterThan', greater, flatten(lhs), flatten(rhs), message, location)
-  end subroutine assertGreaterThan
-
-  subroutine assertGreaterThanOrEqual(lhs, rhs, message, location)
-    class(*), intent(in) :: lhs, rhs
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_order('assertGreaterThanOrEqual', greater_or_equal, flatten(lhs), flatten(rhs), message, location)
-  end subroutine assertGreaterThanOrEqual
 
   subroutine check_order(assertion, relation, lhs, rhs, message, location)
     character(len=*), intent(in) :: assertion
@@ -74,11 +38,11 @@ contains
     end if
     if (lhs%tag == tag_integer .and. rhs%tag == tag_integer) then
       select case (relation)
-      case (less)
+      case (order_less)
         ok = lhs%ints(1) < rhs%ints(1)
-      case (less_or_equal)
+      case (order_less_or_equal)
         ok = lhs%ints(1) <= rhs%ints(1)
-      case (greater)
+      case (order_greater)
         ok = lhs%ints(1) > rhs%ints(1)
       case default
         ok = lhs%ints(1) >= rhs%ints(1)
@@ -91,11 +55,11 @@ contains
         ok = .false.
       else
         select case (relation)
-        case (less)
+        case (order_less)
           ok = lhs%reals(1) < rhs%reals(1)
-        case (less_or_equal)
+        case (order_less_or_equal)
           ok = lhs%reals(1) <= rhs%reals(1)
-        case (greater)
+        case (order_greater)
           ok = lhs%reals(1) > rhs%reals(1)
         case default
           ok = lhs%reals(1) >= rhs%reals(1)
@@ -107,48 +71,6 @@ contains
                                   ' to be ' // trim(words(relation)) // ' ' // element_text(rhs, 1), &
                                   message, location)
   end subroutine check_order
-
-  subroutine is_finite_0(x, message, location)
-    class(*), intent(in) :: x
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_class('assertIsFinite', .true., flatten(x), message, location)
-  end subroutine is_finite_0
-
-  subroutine is_finite_1(x, message, location)
-    class(*), intent(in) :: x(:)
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_class('assertIsFinite', .true., flatten(x), message, location)
-  end subroutine is_finite_1
-
-  subroutine is_finite_2(x, message, location)
-    class(*), intent(in) :: x(:, :)
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_class('assertIsFinite', .true., flatten(x), message, location)
-  end subroutine is_finite_2
-
-  subroutine is_nan_0(x, message, location)
-    class(*), intent(in) :: x
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_class('assertIsNaN', .false., flatten(x), message, location)
-  end subroutine is_nan_0
-
-  subroutine is_nan_1(x, message, location)
-    class(*), intent(in) :: x(:)
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_class('assertIsNaN', .false., flatten(x), message, location)
-  end subroutine is_nan_1
-
-  subroutine is_nan_2(x, message, location)
-    class(*), intent(in) :: x(:, :)
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_class('assertIsNaN', .false., flatten(x), message, location)
-  end subroutine is_nan_2
 
   !> want_finite: every element finite; otherwise: every element NaN.
   subroutine check_class(assertion, want_finite, x, message, location)

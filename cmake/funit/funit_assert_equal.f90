@@ -1,207 +1,23 @@
-!> assertEqual and assertRelativelyEqual with pFUnit's argument order:
-!>   assertEqual(expected, actual[, tolerance][, message][, location])
-!>   assertRelativelyEqual(expected, actual, tolerance[, message][, location])
-!> `expected` and `actual` are any intrinsic scalars (integer, real, logical, character) or
-!> integer/real/logical arrays of rank 1-2; `expected` may be a scalar compared with every
-!> element. The tolerance is real(dp) or default real; without one, reals must match exactly.
-!> Passing: |expected - actual| <= tolerance (absolute) or <= tolerance*|expected| (relative);
-!> NaN never passes, an infinity only matches the same infinity.
+!> The check behind assertEqual and assertRelativelyEqual (their typed generics are generated
+!> into funit_assert_typed by cmake/funit_generate.py, with pFUnit's argument order):
+!> `expected` may be a scalar compared with every element of `actual`; without a tolerance,
+!> reals must match exactly. Passing: |expected - actual| <= tolerance (absolute) or
+!> <= tolerance*|expected| (relative, where a zero expected value fails as pFUnit's zero
+!> denominator does); NaN never passes, an infinity only matches the same infinity.
 module funit_assert_equal
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite, ieee_class, &
     ieee_class_type, operator(==), ieee_status_type, ieee_get_status, ieee_set_status, &
     ieee_set_halting_mode, ieee_usual
-  use, intrinsic :: iso_fortran_env, only: int64, real32
+  use, intrinsic :: iso_fortran_env, only: int64
   use funit_core, only: dp, SourceLocation, flat_value, flatten, element_count, tag_name, &
     element_text, index_text, dims_text, real_text, int_text, funit_fail, &
     tag_integer, tag_real, tag_logical, tag_character
   implicit none
   private
 
-  public :: assertEqual, assertRelativelyEqual
-
-  integer, parameter :: sp = real32
-
-  ! Specific names: equal_<rank of expected>_<rank of actual>[_<tolerance kind>]. A tolerance is
-  ! a required argument of the specifics that take one, which keeps the generic unambiguous
-  ! when the third positional argument is a message instead.
-  interface assertEqual
-    module procedure equal_0_0, equal_0_0_dp, equal_0_0_sp
-    module procedure equal_0_1, equal_0_1_dp, equal_0_1_sp
-    module procedure equal_1_1, equal_1_1_dp, equal_1_1_sp
-    module procedure equal_0_2, equal_0_2_dp, equal_0_2_sp
-    module procedure equal_2_2, equal_2_2_dp, equal_2_2_sp
-  end interface assertEqual
-
-  interface assertRelativelyEqual
-    module procedure relative_0_0_dp, relative_0_0_sp
-    module procedure relative_0_1_dp, relative_0_1_sp
-    module procedure relative_1_1_dp, relative_1_1_sp
-  end interface assertRelativelyEqual
+  public :: check_equal
 
 contains
-
-  subroutine equal_0_0(expected, actual, message, location)
-    class(*), intent(in) :: expected, actual
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), message=message, location=location)
-  end subroutine equal_0_0
-
-  subroutine equal_0_0_dp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual
-    real(dp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), tolerance, message=message, location=location)
-  end subroutine equal_0_0_dp
-
-  subroutine equal_0_0_sp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual
-    real(sp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), real(tolerance, dp), message=message, location=location)
-  end subroutine equal_0_0_sp
-
-  subroutine equal_0_1(expected, actual, message, location)
-    class(*), intent(in) :: expected, actual(:)
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), message=message, location=location)
-  end subroutine equal_0_1
-
-  subroutine equal_0_1_dp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual(:)
-    real(dp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), tolerance, message=message, location=location)
-  end subroutine equal_0_1_dp
-
-  subroutine equal_0_1_sp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual(:)
-    real(sp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), real(tolerance, dp), message=message, location=location)
-  end subroutine equal_0_1_sp
-
-  subroutine equal_1_1(expected, actual, message, location)
-    class(*), intent(in) :: expected(:), actual(:)
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), message=message, location=location)
-  end subroutine equal_1_1
-
-  subroutine equal_1_1_dp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected(:), actual(:)
-    real(dp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), tolerance, message=message, location=location)
-  end subroutine equal_1_1_dp
-
-  subroutine equal_1_1_sp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected(:), actual(:)
-    real(sp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), real(tolerance, dp), message=message, location=location)
-  end subroutine equal_1_1_sp
-
-  subroutine equal_0_2(expected, actual, message, location)
-    class(*), intent(in) :: expected, actual(:, :)
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), message=message, location=location)
-  end subroutine equal_0_2
-
-  subroutine equal_0_2_dp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual(:, :)
-    real(dp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), tolerance, message=message, location=location)
-  end subroutine equal_0_2_dp
-
-  subroutine equal_0_2_sp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual(:, :)
-    real(sp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), real(tolerance, dp), message=message, location=location)
-  end subroutine equal_0_2_sp
-
-  subroutine equal_2_2(expected, actual, message, location)
-    class(*), intent(in) :: expected(:, :), actual(:, :)
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), message=message, location=location)
-  end subroutine equal_2_2
-
-  subroutine equal_2_2_dp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected(:, :), actual(:, :)
-    real(dp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), tolerance, message=message, location=location)
-  end subroutine equal_2_2_dp
-
-  subroutine equal_2_2_sp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected(:, :), actual(:, :)
-    real(sp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertEqual', flatten(expected), flatten(actual), real(tolerance, dp), message=message, location=location)
-  end subroutine equal_2_2_sp
-
-  subroutine relative_0_0_dp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual
-    real(dp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertRelativelyEqual', flatten(expected), flatten(actual), tolerance, .true., message, location)
-  end subroutine relative_0_0_dp
-
-  subroutine relative_0_0_sp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual
-    real(sp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertRelativelyEqual', flatten(expected), flatten(actual), real(tolerance, dp), .true., message, location)
-  end subroutine relative_0_0_sp
-
-  subroutine relative_0_1_dp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual(:)
-    real(dp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertRelativelyEqual', flatten(expected), flatten(actual), tolerance, .true., message, location)
-  end subroutine relative_0_1_dp
-
-  subroutine relative_0_1_sp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected, actual(:)
-    real(sp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertRelativelyEqual', flatten(expected), flatten(actual), real(tolerance, dp), .true., message, location)
-  end subroutine relative_0_1_sp
-
-  subroutine relative_1_1_dp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected(:), actual(:)
-    real(dp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertRelativelyEqual', flatten(expected), flatten(actual), tolerance, .true., message, location)
-  end subroutine relative_1_1_dp
-
-  subroutine relative_1_1_sp(expected, actual, tolerance, message, location)
-    class(*), intent(in) :: expected(:), actual(:)
-    real(sp), intent(in) :: tolerance
-    character(len=*), intent(in), optional :: message
-    type(SourceLocation), intent(in), optional :: location
-    call check_equal('assertRelativelyEqual', flatten(expected), flatten(actual), real(tolerance, dp), .true., message, location)
-  end subroutine relative_1_1_sp
 
   !> Compare element by element (a scalar `expected` against every element of `actual`) and
   !> report the number of mismatches and the first one.
@@ -244,7 +60,15 @@ contains
     ! subtracting two huge values, must report a failure instead of stopping the program.
     call ieee_get_status(fp_status)
     call ieee_set_halting_mode(ieee_usual, .false.)
-
+    ! pFUnit divides by the expected value and refuses a zero one before comparing anything.
+    if (is_relative) then
+      if (any(abs(expected%reals) <= 0.0_dp)) then
+        call ieee_set_status(fp_status)
+        call funit_fail(assertion // ' failed', '    zero denominator: an expected value is 0', &
+                        message, location)
+        return
+      end if
+    end if
     n = element_count(actual)
     n_bad = 0
     first_bad = 0

@@ -38,7 +38,7 @@ module funit_core
 
   public :: anyExceptions
   public :: funit_begin_test, funit_failure_report, funit_fail
-  public :: flatten, element_count, tag_name, element_text, index_text, dims_text
+  public :: flatten, flatten_shaped, element_count, tag_name, element_text, index_text, dims_text
   public :: real_text, int_text
 
   logical, save :: test_failed = .false.
@@ -122,6 +122,10 @@ contains
     class(*), intent(in) :: x(:)
     type(flat_value) :: f
     select type (x)
+    type is (integer(int8))
+      call set_integers(f, int(x, int64))
+    type is (integer(int16))
+      call set_integers(f, int(x, int64))
     type is (integer(int32))
       call set_integers(f, int(x, int64))
     type is (integer(int64))
@@ -142,6 +146,10 @@ contains
     class(*), intent(in) :: x(:, :)
     type(flat_value) :: f
     select type (x)
+    type is (integer(int8))
+      call set_integers(f, int(reshape(x, [size(x)]), int64))
+    type is (integer(int16))
+      call set_integers(f, int(reshape(x, [size(x)]), int64))
     type is (integer(int32))
       call set_integers(f, int(reshape(x, [size(x)]), int64))
     type is (integer(int64))
@@ -157,6 +165,15 @@ contains
     end select
     call set_dims(f, shape(x))
   end function flatten_2
+
+  !> An array of any rank, passed in array element order with its shape.
+  function flatten_shaped(x, dims) result(f)
+    class(*), intent(in) :: x(:)
+    integer, intent(in) :: dims(:)
+    type(flat_value) :: f
+    f = flatten_1(x)
+    call set_dims(f, dims)
+  end function flatten_shaped
 
   subroutine set_integers(f, values)
     type(flat_value), intent(inout) :: f
