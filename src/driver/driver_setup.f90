@@ -108,13 +108,19 @@ contains
     end if
     if (allocated(m%initial_fields)) then
        ! Element value = mean of its nodes' values (nodes without a value count as 0). Our models
-       ! read field 1 with a user field only; a user's VUMAT gets every field and the temperature.
+       ! read field 1 with our user field only; a user's VUMAT gets every field and the
+       ! temperature, a user's VUSDFLD every field.
        do ib = 1, solver%n_blocks
           associate (blk => solver%blocks(ib), mat => m%materials(solver%blocks(ib)%material))
             do e = 1, blk%count
                g = part%elem_global(blk%first + e - 1)
                if (mat%user_code) then
                   blk%temp(e) = mean_initial_field(m, g, 0)
+                  do k = 1, mat%nfieldv
+                     blk%field(e, k) = mean_initial_field(m, g, k)
+                  end do
+               else if (mat%user_field_code) then
+                  ! a user's VUSDFLD on one of our models: every field it is given
                   do k = 1, mat%nfieldv
                      blk%field(e, k) = mean_initial_field(m, g, k)
                   end do

@@ -114,7 +114,7 @@ contains
       m%density = mat%density
       m%nstatev = mat%depvar
       if (mat%option_block(opt_user_field) /= 0) then
-         m%nfieldv = 1
+         m%nfieldv = mat%user_fields
          m%user_field = .true.
          ! As in Abaqus: with a user file, *USER DEFINED FIELD calls the user's VUSDFLD.
          if (user_subroutine) then

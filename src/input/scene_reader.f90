@@ -99,8 +99,9 @@ contains
     call build_steps(deck, layout, model, err)
   end subroutine read_scene
 
-  !> A user's VUMAT receives every field variable the scene defines (nfieldv = the highest
-  !> VARIABLE= of *INITIAL CONDITIONS, TYPE=FIELD), as in Abaqus; our own models keep theirs.
+  !> A user's VUMAT or VUSDFLD receives every field variable the scene defines (nfieldv = the
+  !> highest VARIABLE= of *INITIAL CONDITIONS, TYPE=FIELD, or FIELDS= of *USER DEFINED FIELD if
+  !> larger), as in Abaqus; our own models with our VUSDFLD keep theirs.
   subroutine count_user_fields(model)
     type(model_t), intent(inout) :: model
     integer :: k, n
@@ -110,7 +111,8 @@ contains
        n = max(n, model%initial_fields(k)%variable)
     end do
     do k = 1, model%n_materials
-       if (model%materials(k)%user_code) model%materials(k)%nfieldv = max(model%materials(k)%nfieldv, n)
+       if (model%materials(k)%user_code .or. model%materials(k)%user_field_code) &
+            model%materials(k)%nfieldv = max(model%materials(k)%nfieldv, n)
     end do
   end subroutine count_user_fields
 

@@ -5,7 +5,9 @@
 !> logarithmic strain (VUMAT layout, `(nblock, ncomp)`), and `host_set_block_extra` its state
 !> variables, temperature and, for our plastic models, plastic strain and PEEQ; the external
 !> `vgetvrm` reads them back in Abaqus's flat layout (docs/user_subroutines.md lists the keys).
-!> A key whose values the current block does not have fails (jStatus = 1): never stale data.
+!> A key whose values the current block does not have is an error that names the key and the
+!> keys the block has (`host_available_keys`): user code that ignores jStatus would otherwise
+!> read whatever its buffer held.
 !> `host_set_job` records what vgetjobname, vgetoutdir, vgetrank and vgetnumcpus answer.
 !> `host_set_exit_handler` lets the application decide how `xplb_exit` ends the run (plain
 !> exit, or MPI_Abort in the parallel solver).
@@ -29,6 +31,7 @@ module abaqus_host
 
   public :: exit_handler
   public :: host_set_block, host_set_block_extra, host_get_variable, host_set_exit_handler, host_exit
+  public :: host_available_keys
   public :: host_set_job, host_job_name, host_output_dir, host_rank, host_ranks
 
 contains
@@ -108,6 +111,22 @@ contains
     end subroutine put
   end subroutine host_get_variable
 
+  !> The vgetvrm keys the current block provides, for the error message of an unsupported one.
+  function host_available_keys() result(keys)
+    character(len=:), allocatable :: keys
+
+    keys = ''
+    if (block_size == 0) then
+       keys = 'none (no material block is being computed)'
+       return
+    end if
+    keys = 'S, LE'
+    if (allocated(block_state)) keys = keys // ', SDV'
+    if (allocated(block_temp)) keys = keys // ', TEMP'
+    if (allocated(block_plastic)) keys = keys // ', PE'
+    if (allocated(block_peeq)) keys = keys // ', PEEQ'
+  end function host_available_keys
+
   !> The run's name (output base), output folder, this process's rank and the number of ranks.
   subroutine host_set_job(name, folder, rank, ranks)
     character(len=*), intent(in) :: name, folder
@@ -148,6 +167,9 @@ contains
     integer, intent(in) :: status
 
     if (associated(on_exit)) call on_exit(status)
+    ! A stop code must be a constant in Fortran 2008: 2 (bad input, as the host's own errors
+    ! exit) or 3 (user code asked to stop).
+    if (status == 2) error stop 2
     error stop 3
   end subroutine host_exit
 end module abaqus_host

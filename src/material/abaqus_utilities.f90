@@ -6,10 +6,13 @@
 ! with --user finds them (src/material/user_library.f90).
 
 !> Start-of-increment values of an output variable for the current block.
-!> Keys: S, LE, SDV, TEMP, and PE, PEEQ for our plastic models; others return jStatus = 1.
+!> Keys: S, LE, SDV, TEMP, and PE, PEEQ for our plastic models. Any other key, or PE/PEEQ for a
+!> material that has none (a user's VUMAT), stops the run naming the key (exit 2): Abaqus
+!> returns jStatus /= 0, but user code that does not test it would go on with stale data.
 subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
+  use, intrinsic :: iso_fortran_env, only: error_unit
   use material_kinds, only: dp
-  use abaqus_host, only: host_get_variable
+  use abaqus_host, only: host_get_variable, host_available_keys, host_exit
   implicit none
   character(len=*), intent(in) :: cVar
   real(dp), intent(out) :: rData(*)
@@ -20,6 +23,12 @@ subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
   jData(1) = 0
   cData(1) = ' '
   call host_get_variable(cVar, rData, jStatus)
+  if (jStatus /= 0) then
+     write (error_unit, '(a)') "bulkflow: error: user subroutine called vgetvrm('" // trim(adjustl(cVar)) // &
+          "'): output variable not available for this material; it provides " // host_available_keys() // &
+          ' (PE and PEEQ only for our plastic models, a user VUMAT keeps none)'
+     call host_exit(2)
+  end if
 end subroutine vgetvrm
 
 !> Message from user code. lop: 1 information, -1 warning, -2 error, -3 error and stop.
