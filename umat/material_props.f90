@@ -92,6 +92,12 @@ contains
     lam = 0; shear = 0
     call check_elastic(props, nprops, ok, message)
     if (.not. ok) return
+    ! A count that does not fit the layout is an error: extra constants would be ignored silently.
+    if (nprops /= 2) then
+       ok = .false.
+       write (message, '(a,i0)') 'elasticity takes exactly 2 props (E, nu), got ', nprops
+       return
+    end if
     call lame_constants(props(1), props(2), lam, shear)
   end subroutine decode_elastic
 
@@ -139,8 +145,9 @@ contains
     mc%coh_start = mc%ang_start + 3 * mc%n_ang
     mc%ff_start = mc%coh_start + 2 * mc%n_coh
     needed = mc%ff_start + 2 * mc%n_ff - 1
-    if (nprops < needed) then
-       write (message, '(a,i0,a,i0)') 'Mohr-Coulomb tables need ', needed, ' props, got ', nprops
+    if (nprops /= needed) then
+       write (message, '(a,i0,a,i0)') 'Mohr-Coulomb with these table sizes (props 13, 15, 16) takes exactly ', &
+            needed, ' props, got ', nprops
        return
     end if
 
@@ -224,8 +231,8 @@ contains
     call check_elastic(props, nprops, ok, message)
     if (.not. ok) return
     ok = .false.
-    if (nprops < dp_n_props) then
-       write (message, '(a,i0,a,i0)') 'Drucker-Prager needs ', dp_n_props, ' props, got ', nprops
+    if (nprops /= dp_n_props) then
+       write (message, '(a,i0,a,i0)') 'Drucker-Prager takes exactly ', dp_n_props, ' props, got ', nprops
        return
     end if
     if (nstatev < n_state_plastic) then

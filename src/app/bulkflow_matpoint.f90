@@ -1,7 +1,9 @@
 !> bulkflow-matpoint: drive a VUMAT (ours or a user's) through a laboratory test at one
 !> material point, with mixed stress/strain control.
 !>
-!> Usage: bulkflow-matpoint input.inp [-o out.csv]
+!> Usage: bulkflow-matpoint input.inp [-o out.csv] [--user FILE [--user-include DIR]...]
+!> --user FILE: the user's VUMAT/VUSDFLD file, compiled and loaded at run time as in bulkflow
+!> (docs/user_subroutines.md); the point's *USER MATERIAL then calls the user's vumat.
 !> Reads the keyword input (inputs/matpoint/README.md), runs the path, writes the CSV
 !> (default: the input's name with .csv) and prints a short summary. Any error is one
 !> line "bulkflow: error: file:line: message" on stderr and exit status 2.
@@ -15,9 +17,11 @@ program bulkflow_matpoint
   use matpoint_input, only: read_matpoint_file
   use matpoint_solver, only: matpoint_history_t, run_material_point
   use matpoint_csv, only: write_matpoint_csv, mean_pressure, von_mises
+  use user_library, only: user_library_prepare, user_library_open, user_vusdfld
   implicit none
 
-  character(len=:), allocatable :: input, output, title
+  character(len=:), allocatable :: input, output, title, user_file
+  character(len=1024), allocatable :: user_includes(:)
   type(matpoint_material_t) :: mat
   type(matpoint_path_t) :: path
   type(matpoint_history_t) :: history
@@ -25,7 +29,11 @@ program bulkflow_matpoint
 
   call parse_arguments(input, output, help)
   if (.not. help) then
+     if (len(user_file) > 0) call load_user_file()
      call read_matpoint_file(input, mat, path, title=title)
+     if (len(user_file) > 0 .and. mat%user_field .and. .not. associated(user_vusdfld)) &
+          call report_and_stop(input, 0, '*USER DEFINED FIELD but the user file ' // user_file // &
+          ' defines no VUSDFLD; expected SUBROUTINE VUSDFLD in it')
      call run_material_point(mat, path, history)
      call write_matpoint_csv(output, mat, path, history)
      call print_summary()
@@ -41,6 +49,8 @@ contains
 
     input = ''
     output = ''
+    user_file = ''
+    allocate (user_includes(0))
     help = .false.
     n = command_argument_count()
     i = 0
@@ -49,7 +59,8 @@ contains
        arg = argument(i)
        select case (arg)
        case ('-h', '--help')
-          write (output_unit, '(a)') 'usage: bulkflow-matpoint input.inp [-o out.csv]'
+          write (output_unit, '(a)') 'usage: bulkflow-matpoint input.inp [-o out.csv] ' // &
+               '[--user FILE [--user-include DIR]...]'
           write (output_unit, '(a)') '  runs the material-point test of input.inp through the ' // &
                'VUMAT and writes one CSV row per increment (default out: input name with .csv)'
           help = .true.
@@ -58,6 +69,14 @@ contains
           if (i == n) call usage('-o needs a file name')
           i = i + 1
           output = argument(i)
+       case ('--user')
+          if (i == n) call usage('--user needs a file name')
+          i = i + 1
+          user_file = argument(i)
+       case ('--user-include')
+          if (i == n) call usage('--user-include needs a directory')
+          i = i + 1
+          user_includes = [character(len=1024) :: user_includes, argument(i)]
        case default
           if (arg(1:1) == '-') call usage('unknown option ' // arg)
           if (len(input) > 0) call usage('more than one input file')
@@ -65,6 +84,7 @@ contains
        end select
     end do
     if (len(input) == 0) call usage('no input file')
+    if (size(user_includes) > 0 .and. len(user_file) == 0) call usage('--user-include without --user')
     if (len(output) == 0) then
        dot = index(input, '.', back=.true.)
        if (dot > index(input, '/', back=.true.) + 1) then
@@ -85,10 +105,21 @@ contains
     call get_command_argument(i, arg)
   end function argument
 
+  !> Compile (or find in the cache) and load the --user file; any problem: exit status 2.
+  subroutine load_user_file()
+    character(len=:), allocatable :: library, message
+    integer :: status
+
+    call user_library_prepare(user_file, user_includes, library, message, status)
+    if (status == 0) call user_library_open(library, user_file, message, status)
+    if (status /= 0) call report_and_stop('', 0, message)
+  end subroutine load_user_file
+
   subroutine usage(message)
     character(len=*), intent(in) :: message
 
-    call report_and_stop('', 0, message // ' (usage: bulkflow-matpoint input.inp [-o out.csv])')
+    call report_and_stop('', 0, message // ' (usage: bulkflow-matpoint input.inp [-o out.csv] ' // &
+         '[--user FILE [--user-include DIR]...])')
   end subroutine usage
 
   subroutine print_summary()

@@ -361,6 +361,10 @@ contains
           call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
        end if
        call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
+       call centroids(nb, nd, ne, w%xe_old, w%du, w%vumat%coord)
+       ! constant in time: *INITIAL CONDITIONS, TYPE=TEMPERATURE
+       w%vumat%temp(1:nb) = blk%temp
+       w%vumat%temp_new(1:nb) = blk%temp
     end if
 
     ! PE (only when written): Δε^p = Δε − C⁻¹(σ_new − σ_old); the σ_old part before the call.
@@ -495,6 +499,23 @@ contains
        call exchange_rotations(blk%rotation, w%r_new)
     end if
   end subroutine block_increment
+
+  !> coordMp: the element's integration point (its centroid) at the end of the increment,
+  !> x_n + Δu averaged over the nodes; the third column stays 0 in plane strain.
+  subroutine centroids(nb, nd, ne, xe_old, du, coord)
+    integer, intent(in) :: nb, nd, ne
+    real(dp), intent(in) :: xe_old(:, :, :), du(:, :, :)
+    real(dp), intent(inout) :: coord(:, :)
+    integer :: i, a
+
+    do i = 1, nd
+       coord(1:nb, i) = 0
+       do a = 1, ne
+          coord(1:nb, i) = coord(1:nb, i) + (xe_old(1:nb, i, a) + du(1:nb, i, a))
+       end do
+       coord(1:nb, i) = coord(1:nb, i) / ne
+    end do
+  end subroutine centroids
 
   !> a ↔ b by their allocations (no copy).
   subroutine exchange_rotations(a, b)

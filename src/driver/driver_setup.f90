@@ -9,7 +9,7 @@ module driver_setup
   use parallel_assembly, only: assemble_element_vectors, block_assembly_t, block_assembly_init, &
        assembly_start, assembly_add_block, assembly_finish
   use driver_solver, only: solver_t, element_block_t, build_blocks
-  use driver_vumat_call, only: packaging_modulus
+  use driver_vumat_call, only: checked_packaging_modulus
   use fem_cpe4r, only: cpe4r_geometry, cpe4r_internal_force
   use fem_c3d8r, only: c3d8r_geometry, c3d8r_internal_force
   use fem_corotation, only: identity_rotation, stored_to_global
@@ -61,7 +61,7 @@ contains
     do ib = 1, solver%n_blocks
        k = solver%blocks(ib)%material
        if (.not. known(k)) then
-          moduli(k) = packaging_modulus(m%materials(k), solver%ncomp, solver%nshr)
+          moduli(k) = checked_packaging_modulus(m%materials(k), solver%ncomp, solver%nshr, m%input_file)
           known(k) = .true.
        end if
     end do
@@ -107,13 +107,26 @@ contains
        end do
     end if
     if (allocated(m%initial_fields)) then
-       ! Element value = mean of its nodes' values (nodes without a value count as 0).
+       ! Element value = mean of its nodes' values (nodes without a value count as 0). Our models
+       ! read field 1 with our user field only; a user's VUMAT gets every field and the
+       ! temperature, a user's VUSDFLD every field.
        do ib = 1, solver%n_blocks
-          associate (blk => solver%blocks(ib))
-            if (blk%nfieldv < 1 .or. .not. m%materials(blk%material)%user_field) cycle
+          associate (blk => solver%blocks(ib), mat => m%materials(solver%blocks(ib)%material))
             do e = 1, blk%count
                g = part%elem_global(blk%first + e - 1)
-               blk%field(e, 1) = mean_initial_field(m, g)
+               if (mat%user_code) then
+                  blk%temp(e) = mean_initial_field(m, g, 0)
+                  do k = 1, mat%nfieldv
+                     blk%field(e, k) = mean_initial_field(m, g, k)
+                  end do
+               else if (mat%user_field_code) then
+                  ! a user's VUSDFLD on one of our models: every field it is given
+                  do k = 1, mat%nfieldv
+                     blk%field(e, k) = mean_initial_field(m, g, k)
+                  end do
+               else if (blk%nfieldv >= 1 .and. mat%user_field) then
+                  blk%field(e, 1) = mean_initial_field(m, g, 1)
+               end if
             end do
           end associate
        end do
@@ -145,6 +158,8 @@ contains
       end if
       allocate(blk%stress(nb, solver%ncomp))
       allocate(blk%state(nb, blk%nstatev), blk%field(nb, blk%nfieldv), blk%e_int(nb), blk%e_inel(nb))
+      allocate(blk%temp(nb))
+      blk%temp = 0
       ! Hourglass forces of t_n for the ALLAE work: CPE4R keeps the generalised force Q (nb, 2, 1)
       ! of its one mode (cpe4r_hourglass_update), C3D8R the nodal forces (nb, 3, 8).
       if (m%mesh%element_type == element_cpe4r) then
@@ -194,7 +209,7 @@ contains
       blk%e_int = 0
       blk%e_inel = 0
       blk%wave_modulus = modulus
-      blk%vumat_needs_kinematics = model_from_name(mat%vumat_name) == model_unknown
+      blk%vumat_needs_kinematics = mat%user_code .or. model_from_name(mat%vumat_name) == model_unknown
     end associate
   end subroutine setup_block
 
@@ -259,16 +274,17 @@ contains
     e = 1
   end subroutine locate
 
-  real(dp) function mean_initial_field(m, g)
+  !> Field `variable` (0: the temperature) of global element g: the mean of its nodes' values.
+  real(dp) function mean_initial_field(m, g, variable)
     type(model_t), intent(in) :: m
-    integer, intent(in) :: g
+    integer, intent(in) :: g, variable
     integer :: a, j, i
     real(dp) :: total
 
     total = 0
     do a = 1, m%mesh%nen
        do j = 1, size(m%initial_fields)
-          if (m%initial_fields(j)%variable /= 1) cycle
+          if (m%initial_fields(j)%variable /= variable) cycle
           do i = 1, size(m%initial_fields(j)%nodes)
              if (m%initial_fields(j)%nodes(i) == m%mesh%conn(a, g)) total = total + m%initial_fields(j)%value
           end do

@@ -32,6 +32,7 @@ module driver_solver
      real(dp), allocatable :: stress(:, :)            !< corotational Cauchy stress at t_n
      real(dp), allocatable :: state(:, :)             !< (count, nstatev) SDVs at t_n
      real(dp), allocatable :: field(:, :)             !< (count, nfieldv) field variables at t_n
+     real(dp), allocatable :: temp(:)                 !< (count) temperature (user VUMATs' tempOld/New)
      real(dp), allocatable :: e_int(:), e_inel(:)     !< specific energies (per unit mass)
      real(dp), allocatable :: log_strain(:, :)        !< accumulated corotational strain (LE)
      real(dp), allocatable :: plastic_strain(:, :)    !< corotational plastic strain (PE); (0, ncomp) unless written

@@ -1,10 +1,13 @@
-!> *INITIAL CONDITIONS, TYPE=STRESS | VELOCITY | FIELD -> model%initial_stresses,
-!> initial_velocities, initial_fields (one entry per data line).
+!> *INITIAL CONDITIONS, TYPE=STRESS | VELOCITY | FIELD | TEMPERATURE -> model%initial_stresses,
+!> initial_velocities, initial_fields (one entry per data line; temperature is stored as
+!> variable 0).
 !>
 !> STRESS data follow Abaqus's input-file order: element or element set, s11, s22, s33,
 !> s12, s13, s23 (2D: up to s12); omitted trailing components are zero. They are stored in
 !> VUMAT order 11, 22, 33, 12, 23, 31, so s13 goes to slot 6 and s23 to slot 5.
-!> VELOCITY: node or node set, dof, value. FIELD, VARIABLE=1: node or node set, value.
+!> VELOCITY: node or node set, dof, value. FIELD, VARIABLE=n (default 1): node or node set,
+!> value. TEMPERATURE: node or node set, value (the temperature a VUMAT receives as
+!> tempOld/tempNew, constant in time).
 module scene_initial
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
@@ -17,6 +20,9 @@ module scene_initial
   private
 
   public :: build_initial_conditions
+
+  !> The most field variables a scene may define (VARIABLE=1..max_field_variables).
+  integer, parameter, public :: max_field_variables = 64
 
   !> Input position (after the element field) of each VUMAT stress slot.
   integer, parameter :: input_of_vumat_slot(6) = [1, 2, 3, 4, 6, 5]
@@ -37,7 +43,7 @@ contains
        associate (blk => deck%blocks(i))
          call blk%check_params([character(len=8) :: 'TYPE', 'VARIABLE'], err)
          if (.not. err%raised) call blk%get_string('TYPE', ctype, err, &
-              choices=[character(len=8) :: 'STRESS', 'VELOCITY', 'FIELD'])
+              choices=[character(len=11) :: 'STRESS', 'VELOCITY', 'FIELD', 'TEMPERATURE'])
          if (err%raised) return
          if (ctype /= 'FIELD' .and. blk%has_param('VARIABLE')) then
             call blk%fail('VARIABLE= on *INITIAL CONDITIONS, TYPE=' // ctype // &
@@ -51,8 +57,10 @@ contains
             call read_stress(blk, model, err)
          case ('VELOCITY')
             call read_velocity(blk, model, err)
+         case ('TEMPERATURE')
+            call read_field(blk, model, err, temperature=.true.)
          case default
-            call read_field(blk, model, err)
+            call read_field(blk, model, err, temperature=.false.)
          end select
          if (err%raised) return
        end associate
@@ -117,15 +125,21 @@ contains
     end do
   end subroutine read_velocity
 
-  subroutine read_field(blk, model, err)
+  !> Field variable n (TYPE=FIELD, VARIABLE=n) or the temperature (stored as variable 0).
+  subroutine read_field(blk, model, err, temperature)
     type(keyword_block_t), intent(in) :: blk
     type(model_t), intent(inout) :: model
     type(error_t), intent(inout) :: err
+    logical, intent(in) :: temperature
     type(initial_field_t) :: entry
     integer :: il
 
-    call blk%get_integer('VARIABLE', entry%variable, err, default=1, minimum=1, maximum=1)
-    if (err%raised) return
+    if (temperature) then
+       entry%variable = 0
+    else
+       call blk%get_integer('VARIABLE', entry%variable, err, default=1, minimum=1, maximum=max_field_variables)
+       if (err%raised) return
+    end if
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
          call expect_fields(blk, dl, 2, 2, 'node or node set, value', err)

@@ -42,6 +42,7 @@ module scene_material_options
      real(dp) :: dp_yield = 0
      real(dp), allocatable :: user_props(:)
      integer :: depvar = 0
+     integer :: user_fields = 1                   !< *USER DEFINED FIELD, FIELDS=n (VUSDFLD's nfieldv)
      integer :: flow_kind = 0                     !< umat flow_function kinds: 1 linear, 2 bilinear, 3 table
      real(dp) :: fc0 = 0, slope = 0, t_freeze = 0
      logical :: record_maximum = .false.
@@ -101,8 +102,12 @@ contains
     case (opt_depvar)
        call read_depvar(blk, mat, err)
     case (opt_user_field)
-       call blk%check_params([character(len=8) ::], err)
-       if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines (field 1 is set by VUSDFLD)', err)
+       ! FIELDS=n as bulkflow-matpoint takes it: the nfieldv a VUSDFLD writes (a user's VUSDFLD
+       ! may write more than field 1; the host's arrays must have that many columns).
+       call blk%check_params([character(len=8) :: 'FIELDS'], err)
+       if (.not. err%raised) call blk%get_integer('FIELDS', mat%user_fields, err, default=1, minimum=1, &
+            maximum=64)
+       if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines (the fields are set by VUSDFLD)', err)
     case default
        call read_flow_function(blk, mat, err)
     end select

@@ -22,6 +22,7 @@ module scene_materials
        opt_dp_hardening, opt_user_material, opt_depvar, opt_user_field, opt_flow_function, &
        dp_hardening_shear, dp_hardening_tension
   use scene_util, only: rtoa, where_text, expect_lines, check_name
+  use user_library, only: user_vusdfld, user_library_name
   implicit none
   private
 
@@ -113,8 +114,18 @@ contains
       m%density = mat%density
       m%nstatev = mat%depvar
       if (mat%option_block(opt_user_field) /= 0) then
-         m%nfieldv = 1
+         m%nfieldv = mat%user_fields
          m%user_field = .true.
+         ! As in Abaqus: with a user file, *USER DEFINED FIELD calls the user's VUSDFLD.
+         if (user_subroutine) then
+            if (.not. associated(user_vusdfld)) then
+               call deck%blocks(mat%option_block(opt_user_field))%fail('*USER DEFINED FIELD in ' // &
+                    'material ' // nm // ' but the user file ' // user_library_name() // ' defines no ' // &
+                    'VUSDFLD; expected SUBROUTINE VUSDFLD in it', err)
+               return
+            end if
+            m%user_field_code = .true.
+         end if
       end if
       if (mat%option_block(opt_user_material) /= 0) then
          call translate_user(deck, mat, user_subroutine, m, err)
@@ -209,8 +220,12 @@ contains
     type(error_t), intent(inout) :: err
 
     m%user_material = .true.
+    ! cmname as Abaqus passes it: the material name in upper case, padded with blanks to 80.
     m%vumat_name = mat%name
     m%props = mat%user_props
+    ! With a user file every *USER MATERIAL is the user's, whatever its name (Abaqus's rule);
+    ! our models stay reachable from it through bulkflow_vumat.
+    m%user_code = user_subroutine
     if (user_subroutine) return
     ! Without a user's subroutine our VUMAT will receive the name: check it now.
     if (model_from_name(m%vumat_name) == model_unknown) then

@@ -105,6 +105,7 @@ contains
     if (err%raised) return
     call build_initial_conditions(deck, layout, model, err)
     if (err%raised) return
+    call count_user_fields(model)
     call build_steps(deck, layout, model, err)
   end subroutine read_scene
 
@@ -121,6 +122,23 @@ contains
        return
     end do
   end subroutine refuse_frequency
+
+  !> A user's VUMAT or VUSDFLD receives every field variable the scene defines (nfieldv = the
+  !> highest VARIABLE= of *INITIAL CONDITIONS, TYPE=FIELD, or FIELDS= of *USER DEFINED FIELD if
+  !> larger), as in Abaqus; our own models with our VUSDFLD keep theirs.
+  subroutine count_user_fields(model)
+    type(model_t), intent(inout) :: model
+    integer :: k, n
+
+    n = 0
+    do k = 1, size(model%initial_fields)
+       n = max(n, model%initial_fields(k)%variable)
+    end do
+    do k = 1, model%n_materials
+       if (model%materials(k)%user_code .or. model%materials(k)%user_field_code) &
+            model%materials(k)%nfieldv = max(model%materials(k)%nfieldv, n)
+    end do
+  end subroutine count_user_fields
 
   !> *HEADING: its first data line is the title (one *HEADING at most).
   subroutine read_heading(deck, model, err)

@@ -2,9 +2,15 @@
 !>
 !> Abaqus's `vgetvrm` takes no argument naming the block, so the host must say beforehand
 !> which block is current: `host_set_block` copies its start-of-increment stress and
-!> logarithmic strain (VUMAT layout, `(nblock, ncomp)`), and the external `vgetvrm` reads
-!> them back in Abaqus's flat layout. `host_set_exit_handler` lets the application decide
-!> how `xplb_exit` ends the run (plain exit, or MPI_Abort in the parallel solver).
+!> logarithmic strain (VUMAT layout, `(nblock, ncomp)`), and `host_set_block_extra` its state
+!> variables, temperature and, for our plastic models, plastic strain and PEEQ; the external
+!> `vgetvrm` reads them back in Abaqus's flat layout (docs/user_subroutines.md lists the keys).
+!> A key whose values the current block does not have is an error that names the key and the
+!> keys the block has (`host_available_keys`): user code that ignores jStatus would otherwise
+!> read whatever its buffer held.
+!> `host_set_job` records what vgetjobname, vgetoutdir, vgetrank and vgetnumcpus answer.
+!> `host_set_exit_handler` lets the application decide how `xplb_exit` ends the run (plain
+!> exit, or MPI_Abort in the parallel solver).
 module abaqus_host
   use material_kinds, only: dp
   implicit none
@@ -17,14 +23,20 @@ module abaqus_host
   end interface
 
   real(dp), allocatable :: block_stress(:, :), block_log_strain(:, :)
+  real(dp), allocatable :: block_state(:, :), block_temp(:), block_plastic(:, :), block_peeq(:)
   integer :: block_size = 0, block_components = 0
   procedure(exit_handler), pointer :: on_exit => null()
+  character(len=:), allocatable :: job_name, output_dir
+  integer :: job_rank = 0, job_ranks = 1
 
   public :: exit_handler
-  public :: host_set_block, host_get_variable, host_set_exit_handler, host_exit
+  public :: host_set_block, host_set_block_extra, host_get_variable, host_set_exit_handler, host_exit
+  public :: host_available_keys
+  public :: host_set_job, host_job_name, host_output_dir, host_rank, host_ranks
 
 contains
 
+  !> The current block's stress and LE; the extras of the previous block are forgotten.
   subroutine host_set_block(nblock, ncomp, stress, log_strain)
     integer, intent(in) :: nblock, ncomp
     real(dp), intent(in) :: stress(nblock, ncomp), log_strain(nblock, ncomp)
@@ -38,32 +50,112 @@ contains
     block_components = ncomp
     block_stress(1:nblock, :) = stress
     block_log_strain(1:nblock, :) = log_strain
+    if (allocated(block_state)) deallocate(block_state)
+    if (allocated(block_temp)) deallocate(block_temp)
+    if (allocated(block_plastic)) deallocate(block_plastic)
+    if (allocated(block_peeq)) deallocate(block_peeq)
   end subroutine host_set_block
 
+  !> Further start-of-increment values of the current block (after host_set_block): state
+  !> variables (SDV), temperature (TEMP), and when the material has them plastic strain (PE)
+  !> and equivalent plastic strain (PEEQ).
+  subroutine host_set_block_extra(state, temp, plastic, peeq)
+    real(dp), intent(in) :: state(:, :), temp(:)
+    real(dp), intent(in), optional :: plastic(:, :), peeq(:)
+
+    block_state = state(1:block_size, :)
+    block_temp = temp(1:block_size)
+    if (present(plastic)) then
+       if (size(plastic, 1) >= block_size) block_plastic = plastic(1:block_size, :)
+    end if
+    if (present(peeq)) block_peeq = peeq(1:block_size)
+  end subroutine host_set_block_extra
+
   !> Fill `values` in Abaqus's layout (component-major: all points of component 1 first).
-  !> `status` is 0 on success, 1 for a key this host does not provide or when no block is set.
+  !> `status` is 0 on success, 1 for a key this host does not provide for the current block.
   subroutine host_get_variable(key, values, status)
     character(len=*), intent(in) :: key
     real(dp), intent(out) :: values(*)
     integer, intent(out) :: status
-    integer :: j
 
     status = 1
     if (block_size == 0) return
     select case (trim(adjustl(key)))
     case ('S')
-       do j = 1, block_components
-          values((j - 1) * block_size + 1:j * block_size) = block_stress(1:block_size, j)
-       end do
+       call put(block_stress)
     case ('LE')
-       do j = 1, block_components
-          values((j - 1) * block_size + 1:j * block_size) = block_log_strain(1:block_size, j)
-       end do
+       call put(block_log_strain)
+    case ('SDV')
+       if (.not. allocated(block_state)) return
+       call put(block_state)
+    case ('TEMP')
+       if (.not. allocated(block_temp)) return
+       values(1:block_size) = block_temp
+    case ('PE')
+       if (.not. allocated(block_plastic)) return
+       call put(block_plastic)
+    case ('PEEQ')
+       if (.not. allocated(block_peeq)) return
+       values(1:block_size) = block_peeq
     case default
        return
     end select
     status = 0
+  contains
+    subroutine put(a)
+      real(dp), intent(in) :: a(:, :)
+      integer :: j
+      do j = 1, size(a, 2)
+         values((j - 1) * block_size + 1:j * block_size) = a(1:block_size, j)
+      end do
+    end subroutine put
   end subroutine host_get_variable
+
+  !> The vgetvrm keys the current block provides, for the error message of an unsupported one.
+  function host_available_keys() result(keys)
+    character(len=:), allocatable :: keys
+
+    keys = ''
+    if (block_size == 0) then
+       keys = 'none (no material block is being computed)'
+       return
+    end if
+    keys = 'S, LE'
+    if (allocated(block_state)) keys = keys // ', SDV'
+    if (allocated(block_temp)) keys = keys // ', TEMP'
+    if (allocated(block_plastic)) keys = keys // ', PE'
+    if (allocated(block_peeq)) keys = keys // ', PEEQ'
+  end function host_available_keys
+
+  !> The run's name (output base), output folder, this process's rank and the number of ranks.
+  subroutine host_set_job(name, folder, rank, ranks)
+    character(len=*), intent(in) :: name, folder
+    integer, intent(in) :: rank, ranks
+    job_name = name
+    output_dir = folder
+    job_rank = rank
+    job_ranks = ranks
+  end subroutine host_set_job
+
+  function host_job_name() result(name)
+    character(len=:), allocatable :: name
+    name = 'bulkflow'
+    if (allocated(job_name)) name = job_name
+  end function host_job_name
+
+  function host_output_dir() result(folder)
+    character(len=:), allocatable :: folder
+    folder = '.'
+    if (allocated(output_dir)) folder = output_dir
+  end function host_output_dir
+
+  integer function host_rank()
+    host_rank = job_rank
+  end function host_rank
+
+  integer function host_ranks()
+    host_ranks = job_ranks
+  end function host_ranks
 
   subroutine host_set_exit_handler(handler)
     procedure(exit_handler) :: handler
@@ -75,6 +167,9 @@ contains
     integer, intent(in) :: status
 
     if (associated(on_exit)) call on_exit(status)
+    ! A stop code must be a constant in Fortran 2008: 2 (bad input, as the host's own errors
+    ! exit) or 3 (user code asked to stop).
+    if (status == 2) error stop 2
     error stop 3
   end subroutine host_exit
 end module abaqus_host

@@ -1,12 +1,18 @@
-! Abaqus/Explicit utility routines that user subroutines call (vgetvrm, xplb_abqerr,
-! xplb_exit), provided by the bulkflow host with Abaqus's argument lists. They are external
-! procedures on purpose: user code calls them without an interface, exactly as in Abaqus.
+! Abaqus/Explicit utility routines that user subroutines call (vgetvrm, vgetnumcpus, vgetrank,
+! vgetjobname, vgetoutdir, xplb_abqerr, xplb_exit), provided by the bulkflow host with
+! Abaqus's argument lists (Abaqus User Subroutines Reference Guide, "Utility routines for
+! Abaqus/Explicit"). They are external procedures on purpose: user code calls them without an
+! interface, exactly as in Abaqus. The executables export them, so a user library loaded
+! with --user finds them (src/material/user_library.f90).
 
 !> Start-of-increment values of an output variable for the current block.
-!> Supported keys: 'S' (stress), 'LE' (logarithmic strain); others return jStatus = 1.
+!> Keys: S, LE, SDV, TEMP, and PE, PEEQ for our plastic models. Any other key, or PE/PEEQ for a
+!> material that has none (a user's VUMAT), stops the run naming the key (exit 2): Abaqus
+!> returns jStatus /= 0, but user code that does not test it would go on with stale data.
 subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
+  use, intrinsic :: iso_fortran_env, only: error_unit
   use material_kinds, only: dp
-  use abaqus_host, only: host_get_variable
+  use abaqus_host, only: host_get_variable, host_available_keys, host_exit
   implicit none
   character(len=*), intent(in) :: cVar
   real(dp), intent(out) :: rData(*)
@@ -17,6 +23,12 @@ subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
   jData(1) = 0
   cData(1) = ' '
   call host_get_variable(cVar, rData, jStatus)
+  if (jStatus /= 0) then
+     write (error_unit, '(a)') "bulkflow: error: user subroutine called vgetvrm('" // trim(adjustl(cVar)) // &
+          "'): output variable not available for this material; it provides " // host_available_keys() // &
+          ' (PE and PEEQ only for our plastic models, a user VUMAT keeps none)'
+     call host_exit(2)
+  end if
 end subroutine vgetvrm
 
 !> Message from user code. lop: 1 information, -1 warning, -2 error, -3 error and stop.
@@ -81,3 +93,39 @@ subroutine xplb_exit()
   implicit none
   call host_exit(3)
 end subroutine xplb_exit
+
+!> Number of processes of the run (Abaqus: CPUs of the analysis).
+subroutine vgetnumcpus(numCpus)
+  use abaqus_host, only: host_ranks
+  implicit none
+  integer, intent(out) :: numCpus
+  numCpus = host_ranks()
+end subroutine vgetnumcpus
+
+!> This process's number, 0 for the first (MPI rank).
+subroutine vgetrank(kProcessNum)
+  use abaqus_host, only: host_rank
+  implicit none
+  integer, intent(out) :: kProcessNum
+  kProcessNum = host_rank()
+end subroutine vgetrank
+
+!> The job name: bulkflow's output base name (--output, else the scene's name).
+subroutine vgetjobname(jobName, jobNameLen)
+  use abaqus_host, only: host_job_name
+  implicit none
+  character(len=*), intent(out) :: jobName
+  integer, intent(out) :: jobNameLen
+  jobName = host_job_name()
+  jobNameLen = min(len(jobName), len(host_job_name()))
+end subroutine vgetjobname
+
+!> The folder the outputs are written to.
+subroutine vgetoutdir(outDir, outDirLen)
+  use abaqus_host, only: host_output_dir
+  implicit none
+  character(len=*), intent(out) :: outDir
+  integer, intent(out) :: outDirLen
+  outDir = host_output_dir()
+  outDirLen = min(len(outDir), len(host_output_dir()))
+end subroutine vgetoutdir

@@ -17,7 +17,9 @@
 !> The vusdfld receives the `*USER MATERIAL` constants as its props (our VUSDFLD uses none).
 module matpoint_vumat_door
   use material_kinds, only: dp
-  use abaqus_host, only: host_set_block
+  use abaqus_host, only: host_set_block, host_set_block_extra
+  use material_entry, only: vumat_entry, vusdfld_entry
+  use user_library, only: user_library_loaded
   use matpoint_material, only: matpoint_material_t, material_cmname
   use matpoint_kinematics, only: stretch_from_log_strain, defgrad_from_stretch
   implicit none
@@ -150,10 +152,12 @@ contains
     type(vumat_block_t), intent(inout) :: blk
     type(matpoint_material_t), intent(in) :: mat
     real(dp), intent(in) :: step_time, total_time, dt
-    external :: vumat
+    procedure(), pointer :: vumat
     character(len=80) :: cmname
     integer :: nprops, lanneal
 
+    ! With --user the point's material is the user's (bulkflow-matpoint reads *USER MATERIAL only).
+    vumat => vumat_entry(user_library_loaded())
     cmname = material_cmname(mat)
     nprops = size(mat%props)
     lanneal = 0
@@ -172,13 +176,14 @@ contains
     type(vumat_block_t), intent(inout) :: blk
     type(matpoint_material_t), intent(in) :: mat
     real(dp), intent(in) :: step_time, total_time, dt
-    external :: vusdfld
+    procedure(), pointer :: vusdfld
     character(len=80) :: cmname
     integer :: nprops, k, i
     integer, parameter :: k_int_pt = 1, k_layer = 1, k_sec_pt = 1
     real(dp) :: direct(blk%nblock, 3, 3), t_dir(blk%nblock, 3, 3)
     real(dp) :: field(blk%nblock, blk%nfieldv), state_out(blk%nblock, blk%nstatev)
 
+    vusdfld => vusdfld_entry(user_library_loaded())
     cmname = material_cmname(mat)
     nprops = size(mat%props)
     direct = 0.0_dp
@@ -191,6 +196,7 @@ contains
     field = blk%field_old
     state_out = blk%state_old
     call host_set_block(blk%nblock, blk%ncomp, blk%stress_old, blk%log_strain_old)
+    call host_set_block_extra(blk%state_old, blk%temp_old)
     call vusdfld(blk%nblock, blk%nstatev, blk%nfieldv, nprops, blk%ndir, blk%nshr, &
          blk%jblock(5:), k_int_pt, k_layer, k_sec_pt, &
          step_time, total_time, dt, cmname, &

@@ -27,7 +27,8 @@ module model
      real(dp) :: stress(6) = 0
   end type initial_stress_t
 
-  !> *INITIAL CONDITIONS, TYPE=FIELD on nodes (field 1); element values are nodal means.
+  !> *INITIAL CONDITIONS, TYPE=FIELD (VARIABLE=n) or TYPE=TEMPERATURE (variable 0) on nodes;
+  !> element values are nodal means.
   type, public :: initial_field_t
      integer, allocatable :: nodes(:)
      integer :: variable = 1

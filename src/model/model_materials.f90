@@ -17,6 +17,10 @@ module model_materials
      integer :: nfieldv = 0                      !< 1 with *USER DEFINED FIELD (field 1), else 0
      logical :: user_field = .false.             !< call vusdfld before vumat
      logical :: user_material = .false.          !< props come from *USER MATERIAL
+     !> The --user library's vumat (a *USER MATERIAL with a user file loaded), not ours.
+     logical :: user_code = .false.
+     !> The --user library's vusdfld (*USER DEFINED FIELD with a user file defining VUSDFLD).
+     logical :: user_field_code = .false.
      character(len=256) :: source = ''           !< file:line of *MATERIAL, for messages
   end type material_t
 

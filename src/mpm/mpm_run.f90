@@ -44,7 +44,7 @@ module mpm_run
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, &
        mpm_restart_outputs
-  use driver_vumat_call, only: vumat_work_t, vumat_work_init, call_material, packaging_modulus
+  use driver_vumat_call, only: vumat_work_t, vumat_work_init, call_material, checked_packaging_modulus
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
   use output_timer, only: timer_set_t, timer_init, timer_register, timer_start, timer_stop, timer_report, &
@@ -411,8 +411,9 @@ contains
       nfv = 1
       any_user_field = .false.
       do k = 1, m%n_materials
-         st%modulus(k) = packaging_modulus(m%materials(k), st%nc, st%nshr)
-         st%needs_kinematics(k) = model_from_name(m%materials(k)%vumat_name) == model_unknown
+         st%modulus(k) = checked_packaging_modulus(m%materials(k), st%nc, st%nshr, m%input_file)
+         st%needs_kinematics(k) = m%materials(k)%user_code .or. &
+              model_from_name(m%materials(k)%vumat_name) == model_unknown
          nsv = max(nsv, m%materials(k)%nstatev)
          nfv = max(nfv, m%materials(k)%nfieldv)
          if (m%materials(k)%user_field) any_user_field = .true.
@@ -954,6 +955,8 @@ contains
        call vumat_defgrad(nb, nd, f_new, st%work(iw)%defgrad_new)
        call vumat_stretch(nb, nd, b%rot, b%f, st%work(iw)%stretch_old)
        call vumat_stretch(nb, nd, r_new, f_new, st%work(iw)%stretch_new)
+       ! coordMp: the particle's position (the third column stays 0 in 2D)
+       st%work(iw)%coord(1:nb, 1:nd) = b%x(1:nb, 1:nd)
     end if
     do p = 1, nb
        if (nd == 2) then
@@ -994,6 +997,7 @@ contains
     integer, intent(in) :: rows
 
     call vumat_work_init(w, rows, st%nc, st%nshr, st%work_statev, st%work_fieldv)
+    w%point_kind = 'particle'
     w%stretch_old = 0
     w%stretch_old(:, 1:3) = 1
     w%defgrad_old = 0

@@ -1,0 +1,207 @@
+#!/usr/bin/env python3
+"""Run public third-party VUMATs/VUSDFLDs, unchanged, with --user in the four hosts and check
+each against a closed form (docs/user_subroutines.md lists the files and the results).
+
+The files are not part of bulkflow: download them first (their repositories are listed in
+CASES below and in the docs), into one folder, under the names CASES gives, e.g.
+
+    git clone https://github.com/irfancn/Abaqus-VUMAT-Johnson-Cook /tmp/jc
+    cp /tmp/jc/vumat_JC.for /tmp/public_vumats/irfancn_vumat_JC.for
+    python3 scripts/check_public_vumats.py --dir /tmp/public_vumats [--build build]
+
+Hosts: C3D8R and CPE4R (a homogeneous uniaxial-strain compression, every node prescribed),
+MPM (a 3D column settling under gravity between frictionless walls: sigma_yy = -rho g (H - y)
+whatever the material) and bulkflow-matpoint (an oedometer test). A host a file cannot serve
+(a VUMAT written for 3D only) is skipped and said so.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parent.parent
+spec = importlib.util.spec_from_file_location('user_checks', REPO / 'tests' / 'user' / 'check_user_subroutines.py')
+uc = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(uc)
+
+
+def jc_check(props):
+    """J2 with Johnson-Cook hardening at the reference temperature, no rate term: on yielding,
+    the Mises stress equals A + B eps_p^n with eps_p = SDV2."""
+    a_, b_, n_ = props[2], props[3], props[5]
+
+    def check(stress6, sdv):
+        s = np.asarray(stress6, float)
+        p = s[:3].mean()
+        d = s.copy()
+        d[:3] -= p
+        q = math.sqrt(1.5 * (d[0] ** 2 + d[1] ** 2 + d[2] ** 2 + 2 * (d[3] ** 2 + d[4] ** 2 + d[5] ** 2)))
+        ep = sdv[1]
+        want = a_ + b_ * ep ** n_
+        if ep <= 0:
+            raise uc.Failed(f'no plastic strain (q = {q:.6e}); the path must yield')
+        return q, want
+    return check
+
+
+def ice_check(props):
+    """Pressure-dependent (Tsai-Wu) ice: on yielding, J2 = a0 + a1 p + a2 p^2, p = -tr(sigma)/3."""
+    a0, a1, a2 = props[2], props[3], props[4]
+
+    def check(stress6, sdv):
+        s = np.asarray(stress6, float)
+        p = -s[:3].mean()
+        d = s.copy()
+        d[:3] += p
+        j2 = 0.5 * (d[0] ** 2 + d[1] ** 2 + d[2] ** 2) + d[3] ** 2 + d[4] ** 2 + d[5] ** 2
+        if sdv[6] <= 0:
+            raise uc.Failed(f'no plastic strain (J2 = {j2:.6e}); the path must yield')
+        return j2, a0 + a1 * p + a2 * p * p
+    return check
+
+
+# name -> (repository, path in it, file name in --dir, props, depvar, kinds of host, check, comment)
+CASES = {
+    'johnson_cook': dict(
+        repo='irfancn/Abaqus-VUMAT-Johnson-Cook', path='vumat_JC.for', file='irfancn_vumat_JC.for',
+        # E, nu, A, B, C (rate: 0), n, m, rate0, Tr, Tm, rho, TQ, Cp, WH (heating: 0)
+        props=[2.1e11, 0.3, 8e8, 6e8, 0.0, 0.168, 1.1, 1.0, 293.0, 1700.0, 7800.0, 34.0, 460.0, 0.0],
+        depvar=6, density=7800.0, hosts=['c3d8r', 'matpoint', 'mpm3d'], check=jc_check, tol=1e-6, strain=-0.02,
+        what='J2 plasticity with Johnson-Cook hardening (3D only: it reads stress components 1..6)'),
+    'ice_tsai_wu': dict(
+        repo='NTNU-IMT/Ice-Elastoplastic-Material-Model', path='src/VUMAT-ICE-Elastoplastic.for',
+        file='ntnu_imt_VUMAT-ICE-Elastoplastic.for',
+        # MPa: E, nu, a0, a1, a2, eps0 (failure strain: 10, no damage), pcut, M, N, Gf1, Gf2, alphad
+        props=[9500.0, 0.3, 22.93, 2.06, -0.023, 10.0, -2.0, 1.0, 0.75, 1.0, 1.0, 1.0],
+        # units m, MN, s: density in 1e6 kg/m^3 (ice 900 kg/m^3)
+        depvar=29, density=9.0e-4, hosts=['cpe4r', 'c3d8r', 'matpoint', 'mpm3d'], check=ice_check, tol=1e-4,
+        # far from the cap of the ellipse (p near 100 MPa), where the file's return mapping stops
+        # after its 200 iterations without reaching the surface in large increments
+        strain=-0.004,
+        what='pressure-dependent (Tsai-Wu) plasticity of ice, single-precision locals'),
+}
+
+
+def run(cmd, cwd):
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
+    proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=env, timeout=900)
+    if proc.returncode != 0:
+        raise uc.Failed(f'exit {proc.returncode}: {" ".join(cmd)}\n{proc.stdout[-1500:]}{proc.stderr[-1500:]}')
+    return proc
+
+
+def props_text(props):
+    return ',\n'.join(', '.join(repr(float(v)) for v in props[i:i + 8]) for i in range(0, len(props), 8))
+
+
+def material_block(name, case):
+    return (f'*MATERIAL, NAME={name}\n*DENSITY\n{case["density"]!r}\n'
+            f'*USER MATERIAL, CONSTANTS={len(case["props"])}\n{props_text(case["props"])}\n'
+            f'*DEPVAR\n{case["depvar"]}\n')
+
+
+def host_elements(case, user_file, work: Path, ndim: int, check):
+    work.mkdir(parents=True, exist_ok=True)
+    scene = work / 'compress.inp'
+    stretch = [0.0, case['strain'], 0.0]
+    uc.element_scene(scene, ndim, (1,) * ndim, stretch, [0, 0, 1], 0.0, 2e-3)
+    text = scene.read_text()
+    start = text.index('*MATERIAL')
+    end = text.index('*INITIAL CONDITIONS')
+    text = text[:start] + material_block('PUBLIC', case) + text[end:].split('*AMPLITUDE', 1)[0] \
+        + '*AMPLITUDE' + text[end:].split('*AMPLITUDE', 1)[1]
+    text = text.replace('MATERIAL=PROBE-NEO', 'MATERIAL=PUBLIC')
+    scene.write_text(text)
+    run([str(BULKFLOW), str(scene), '--quiet', '--user', str(user_file)], work)
+    fr = uc.last_frame(work / 'compress.h5', 'frames')
+    s = fr['S'][0]
+    s6 = list(s) if len(s) == 6 else [s[0], s[1], s[2], s[3], 0.0, 0.0]
+    return check(s6, fr['SDV'][0])
+
+
+def host_matpoint(case, user_file, work: Path, check):
+    work.mkdir(parents=True, exist_ok=True)
+    inp = work / 'oedometer.inp'
+    inp.write_text('*HEADING\npublic VUMAT, oedometer\n' + material_block('PUBLIC', case)
+                   + f'*TEST, TYPE=OEDOMETER\n*STAGE, STRAIN={case["strain"]}, INC=100\n')
+    run([str(MATPOINT), str(inp), '-o', 'oedometer.csv', '--user', str(user_file)], work)
+    data = np.genfromtxt(work / 'oedometer.csv', delimiter=',', names=True)
+    s6 = [data[c][-1] for c in ('s11', 's22', 's33', 's12', 's23', 's31')]
+    sdv = [data[f'SDV{i}'][-1] for i in range(1, case['depvar'] + 1)]
+    return check(s6, sdv)
+
+
+def host_mpm3d(case, user_file, work: Path):
+    """Vertical equilibrium of a column between frictionless walls, any material."""
+    work.mkdir(parents=True, exist_ok=True)
+    text = (REPO / 'inputs' / 'mpm' / 'column_k0_3d.inp').read_text()
+    start = text.index('*MATERIAL')
+    end = text.index('*PARTICLES')
+    text = text[:start] + material_block('SOIL', case) + text[end:]
+    text = text.replace('*ELEMENT OUTPUT\nS\n', '*ELEMENT OUTPUT\nS, SDV\n')
+    scene = work / 'column.inp'
+    scene.write_text(text)
+    run([str(BULKFLOW), str(scene), '--quiet', '--user', str(user_file)], work)
+    fr = uc.last_frame(work / 'column.h5', 'particles')
+    y = fr['coordinates'][:, 1]
+    rho, g, height = case['density'], 9.81, 1.0
+    want = -rho * g * height * (y.max() + 0.05 - y) / (y.max() + 0.05)
+    err = float(np.max(np.abs(fr['S'][:, 1] - want)))
+    return err, 0.05 * rho * g * height
+
+
+def main() -> int:
+    global BULKFLOW, MATPOINT
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument('--dir', type=Path, required=True, help='folder with the downloaded files')
+    p.add_argument('--build', type=Path, default=REPO / 'build')
+    p.add_argument('--work', type=Path, default=Path('/tmp/bulkflow_public_vumats'))
+    a = p.parse_args()
+    BULKFLOW = a.build / 'bin' / 'bulkflow'
+    MATPOINT = a.build / 'bin' / 'bulkflow-matpoint'
+    os.environ.setdefault('BULKFLOW_CACHE_DIR', str(a.work / 'cache'))
+    failures = 0
+    for name, case in CASES.items():
+        user_file = a.dir / case['file']
+        print(f'{name}: {case["repo"]} {case["path"]} ({case["what"]})')
+        if not user_file.exists():
+            print(f'  missing {user_file}: download it first')
+            failures += 1
+            continue
+        check = case['check'](case['props'])
+        for host in ('cpe4r', 'c3d8r', 'mpm3d', 'matpoint'):
+            if host not in case['hosts']:
+                print(f'  {host:9s} skipped (the file does not serve it)')
+                continue
+            try:
+                work = a.work / name / host
+                if host == 'mpm3d':
+                    err, tol = host_mpm3d(case, user_file, work)
+                    ok = err <= tol
+                    print(f'  {host:9s} sigma_yy vs -rho g (H - y): max error {err:.3e} (limit {tol:.1e})'
+                          f' {"OK" if ok else "FAILED"}')
+                else:
+                    if host == 'matpoint':
+                        got, want = host_matpoint(case, user_file, work, check)
+                    else:
+                        got, want = host_elements(case, user_file, work, 2 if host == 'cpe4r' else 3, check)
+                    ok = abs(got - want) <= case['tol'] * abs(want)
+                    print(f'  {host:9s} yield measure {got:.9e}, closed form {want:.9e}, relative error '
+                          f'{abs(got - want) / abs(want):.2e} {"OK" if ok else "FAILED"}')
+                failures += 0 if ok else 1
+            except uc.Failed as exc:
+                print(f'  {host:9s} FAILED: {exc}')
+                failures += 1
+    print('all passed' if failures == 0 else f'{failures} failure(s)')
+    return 0 if failures == 0 else 1
+
+
+if __name__ == '__main__':
+    sys.exit(main())
