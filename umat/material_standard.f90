@@ -25,6 +25,11 @@ module material_standard
 
   public :: material_umat, message_length
 
+  !> A name containing this token (e.g. MC-SAND-ELASTICTANGENT) gets the elastic matrix as
+  !> DDSDDE instead of the consistent tangent: the same stresses, for comparing Newton rates or
+  !> as a robust fallback. Not a model option: the stress update does not change.
+  character(len=*), parameter :: elastic_tangent_token = '-ELASTICTANGENT'
+
   !> Explicit (VUMAT) slot of each Standard component: 13 ↔ 31 and 23 change places.
   integer, parameter :: explicit_slot(6) = [1, 2, 3, 4, 6, 5]
 
@@ -86,7 +91,11 @@ contains
     spd = e_inel_new(1)
     sse = e_int_new(1) - e_inel_new(1)
 
-    call point_tangent(choice, ntens, stress_old(1, :), strain_inc(1, :), state_new(1, :), c)
+    if (index(name, elastic_tangent_token) > 0) then
+       call elastic_tangent(choice%lam, choice%shear, c)
+    else
+       call point_tangent(choice, ntens, stress_old(1, :), strain_inc(1, :), state_new(1, :), c)
+    end if
     call tangent_to_standard(c, ntens, ddsdde)
     ok = .true.
   end subroutine material_umat
