@@ -1,15 +1,23 @@
-# Assemble the self-contained Abaqus user-subroutine file: every material kernel module in
-# dependency order, then vumat and vusdfld, behind one `!DIR$ FREEFORM` line (Intel/Abaqus
-# honours it; gfortran needs -ffree-form). Run as:
-#   cmake -DOUTPUT=<file> -DSOURCES="<a.f90|b.f90|...>" -P abaqus_single_file.cmake
+# Assemble a self-contained Abaqus user-subroutine file: every material kernel module in
+# dependency order, then the entry points (Explicit: vumat and vusdfld; Standard: umat), behind
+# one `!DIR$ FREEFORM` line (Intel/Abaqus honours it; gfortran needs -ffree-form). Run as:
+#   cmake -DOUTPUT=<file> -DKIND=explicit|standard -DSOURCES="<a.f90|b.f90|...>" -P abaqus_single_file.cmake
 if(NOT OUTPUT OR NOT SOURCES)
   message(FATAL_ERROR "abaqus_single_file.cmake needs -DOUTPUT and -DSOURCES")
 endif()
 string(REPLACE "|" ";" SOURCES "${SOURCES}")
+get_filename_component(output_name "${OUTPUT}" NAME)
 set(text "!DIR$ FREEFORM\n")
-string(APPEND text "! bulkflow material subroutines for Abaqus/Explicit (VUMAT + VUSDFLD), one file.\n")
-string(APPEND text "! Generated from the bulkflow sources; do not edit. Use:\n")
-string(APPEND text "!   abaqus job=<job> user=bulkflow_abaqus.f double=both\n")
+if(KIND STREQUAL "standard")
+  string(APPEND text "! bulkflow material subroutines for Abaqus/Standard (UMAT with consistent tangent), one file.\n")
+  string(APPEND text "! Generated from the bulkflow sources; do not edit. Use:\n")
+  string(APPEND text "!   abaqus job=<job> user=${output_name}\n")
+  string(APPEND text "! or link it into CalculiX (bulkflow scripts/build_ccx_umat.sh).\n")
+else()
+  string(APPEND text "! bulkflow material subroutines for Abaqus/Explicit (VUMAT + VUSDFLD), one file.\n")
+  string(APPEND text "! Generated from the bulkflow sources; do not edit. Use:\n")
+  string(APPEND text "!   abaqus job=<job> user=${output_name} double=both\n")
+endif()
 string(APPEND text "! Material names and props: see umat/README.md of bulkflow.\n")
 foreach(src IN LISTS SOURCES)
   file(READ "${src}" body)

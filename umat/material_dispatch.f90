@@ -11,6 +11,15 @@ module material_dispatch
   private
 
   public :: material_vumat, message_length
+  public :: decode_material, update_material
+
+  !> A model chosen by name with its decoded constants (the tables stay in `props`).
+  type, public :: material_choice_t
+     integer :: model = model_unknown
+     real(dp) :: lam = 0, shear = 0
+     type(mohr_coulomb_props_t) :: mc
+     type(drucker_prager_props_t) :: dpp
+  end type material_choice_t
 
 contains
 
@@ -30,10 +39,8 @@ contains
     real(dp), intent(out) :: e_int_new(nblock), e_inel_new(nblock)
     logical, intent(out) :: ok
     character(len=message_length), intent(out) :: message
-    integer :: model, ncomp
-    real(dp) :: lam, shear
-    type(mohr_coulomb_props_t) :: mc
-    type(drucker_prager_props_t) :: dpp
+    integer :: ncomp
+    type(material_choice_t) :: choice
 
     ok = .false.
     ncomp = ndir + nshr
@@ -42,27 +49,9 @@ contains
             ' is not supported (plane strain/axisymmetric 3,1 or 3D 3,3; no plane stress)'
        return
     end if
-    model = model_from_name(cmname)
-    if (model == model_unknown) then
-       message = 'unknown material name "' // trim(cmname) // '": ' // model_names_help()
-       return
-    end if
-
     ! Validate first, whatever the call: bad props must stop the data check, not increment 1.
-    select case (model)
-    case (model_elastic)
-       call decode_elastic(props, nprops, lam, shear, ok, message)
-    case (model_mohr_coulomb)
-       call decode_mohr_coulomb(props, nprops, nstatev, nfieldv, mc, ok, message)
-       lam = mc%lam; shear = mc%shear
-    case (model_drucker_prager)
-       call decode_drucker_prager(props, nprops, nstatev, dpp, ok, message)
-       lam = dpp%lam; shear = dpp%shear
-    end select
-    if (.not. ok) then
-       message = 'material ' // trim(cmname) // ': ' // trim(message)
-       return
-    end if
+    call decode_material(cmname, props, nprops, nstatev, nfieldv, choice, ok, message)
+    if (.not. ok) return
 
     e_inel_new = e_inel_old
     if (lanneal == 1) then
@@ -74,24 +63,70 @@ contains
     end if
     if (max(abs(step_time), abs(total_time)) < tiny(1.0_dp)) then
        ! Packaging call: the host only wants the elastic response to size the wave speed.
-       call update_elastic_block(nblock, ncomp, lam, shear, density, strain_inc, stress_old, stress_new, &
-            e_int_old, e_int_new)
+       call update_elastic_block(nblock, ncomp, choice%lam, choice%shear, density, strain_inc, stress_old, &
+            stress_new, e_int_old, e_int_new)
        state_new = state_old
        return
     end if
+    call update_material(choice, nblock, ncomp, nstatev, nfieldv, nprops, props, total_time, density, &
+         strain_inc, field_new, stress_old, state_old, stress_new, state_new, e_int_old, e_int_new, &
+         e_inel_old, e_inel_new)
+  end subroutine material_vumat
 
-    select case (model)
+  !> The model named by `cmname` (upper case, umat/README.md) with its checked constants.
+  !> On failure `ok` is false and `message` names the material and what is wrong.
+  pure subroutine decode_material(cmname, props, nprops, nstatev, nfieldv, choice, ok, message)
+    character(len=*), intent(in) :: cmname
+    integer, intent(in) :: nprops, nstatev, nfieldv
+    real(dp), intent(in) :: props(nprops)
+    type(material_choice_t), intent(out) :: choice
+    logical, intent(out) :: ok
+    character(len=message_length), intent(out) :: message
+
+    ok = .false.
+    choice%model = model_from_name(cmname)
+    select case (choice%model)
     case (model_elastic)
-       call update_elastic_block(nblock, ncomp, lam, shear, density, strain_inc, stress_old, stress_new, &
-            e_int_old, e_int_new)
-       state_new = state_old
+       call decode_elastic(props, nprops, choice%lam, choice%shear, ok, message)
     case (model_mohr_coulomb)
-       call update_mohr_coulomb_block(nblock, ncomp, nstatev, nfieldv, nprops, props, mc, total_time, &
-            density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, &
+       call decode_mohr_coulomb(props, nprops, nstatev, nfieldv, choice%mc, ok, message)
+       choice%lam = choice%mc%lam; choice%shear = choice%mc%shear
+    case (model_drucker_prager)
+       call decode_drucker_prager(props, nprops, nstatev, choice%dpp, ok, message)
+       choice%lam = choice%dpp%lam; choice%shear = choice%dpp%shear
+    case default
+       message = 'unknown material name "' // trim(cmname) // '": ' // model_names_help()
+       return
+    end select
+    if (.not. ok) message = 'material ' // trim(cmname) // ': ' // trim(message)
+  end subroutine decode_material
+
+  !> Stress update of a block of points by the chosen model (not the packaging call).
+  pure subroutine update_material(choice, nblock, ncomp, nstatev, nfieldv, nprops, props, total_time, &
+       density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, e_int_old, &
+       e_int_new, e_inel_old, e_inel_new)
+    type(material_choice_t), intent(in) :: choice
+    integer, intent(in) :: nblock, ncomp, nstatev, nfieldv, nprops
+    real(dp), intent(in) :: props(nprops), total_time
+    real(dp), intent(in) :: density(nblock), strain_inc(nblock, ncomp), field_new(nblock, nfieldv)
+    real(dp), intent(in) :: stress_old(nblock, ncomp), state_old(nblock, nstatev)
+    real(dp), intent(out) :: stress_new(nblock, ncomp), state_new(nblock, nstatev)
+    real(dp), intent(in) :: e_int_old(nblock), e_inel_old(nblock)
+    real(dp), intent(out) :: e_int_new(nblock), e_inel_new(nblock)
+
+    select case (choice%model)
+    case (model_mohr_coulomb)
+       call update_mohr_coulomb_block(nblock, ncomp, nstatev, nfieldv, nprops, props, choice%mc, &
+            total_time, density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, &
             e_int_old, e_int_new, e_inel_old, e_inel_new)
     case (model_drucker_prager)
-       call update_drucker_prager_block(nblock, ncomp, nstatev, dpp, density, strain_inc, stress_old, &
-            state_old, stress_new, state_new, e_int_old, e_int_new, e_inel_old, e_inel_new)
+       call update_drucker_prager_block(nblock, ncomp, nstatev, choice%dpp, density, strain_inc, &
+            stress_old, state_old, stress_new, state_new, e_int_old, e_int_new, e_inel_old, e_inel_new)
+    case default
+       call update_elastic_block(nblock, ncomp, choice%lam, choice%shear, density, strain_inc, &
+            stress_old, stress_new, e_int_old, e_int_new)
+       state_new = state_old
+       e_inel_new = e_inel_old
     end select
-  end subroutine material_vumat
+  end subroutine update_material
 end module material_dispatch
