@@ -17,6 +17,7 @@ module keyword_numbers
 
   public :: upper_case, is_real_text, is_integer_text, is_integer_syntax
   public :: text_to_real, text_to_integer, int_text, real_text, normalize_name
+  public :: written_exponent
 
   interface
      function c_strtod(str, endptr) bind(c, name='strtod') result(x)
@@ -194,7 +195,7 @@ contains
   !> ("123.4e5" 7, "0.05" -2; 0 for a zero), the exponent clamped against integer overflow.
   pure integer function decimal_exponent(text) result(e10)
     character(len=*), intent(in) :: text
-    integer :: k, n, before, lead, expo, sgn
+    integer :: k, n, before, lead, expo
     logical :: in_fraction, found
 
     n = len(text)
@@ -216,18 +217,7 @@ contains
        end if
        k = k + 1
     end do
-    expo = 0
-    if (k < n) then
-       k = k + 1
-       sgn = 1
-       if (text(k:k) == '-') sgn = -1
-       if (text(k:k) == '+' .or. text(k:k) == '-') k = k + 1
-       do while (k <= n)
-          if (expo < 100000) expo = 10 * expo + (iachar(text(k:k)) - iachar('0'))
-          k = k + 1
-       end do
-       expo = sgn * expo
-    end if
+    expo = written_exponent(text(1:n), k)
     if (.not. found) then
        e10 = 0
     else if (before > 0) then
@@ -236,6 +226,27 @@ contains
        e10 = -(lead + 1) + expo
     end if
   end function decimal_exponent
+
+  !> The exponent written after the exponent letter at `k` of a text of the strict real syntax
+  !> (0 when none), clamped against integer overflow.
+  pure integer function written_exponent(text, k) result(expo)
+    character(len=*), intent(in) :: text
+    integer, intent(in) :: k
+    integer :: j, n, sgn
+
+    n = len(text)
+    expo = 0
+    if (k >= n) return
+    j = k + 1
+    sgn = 1
+    if (text(j:j) == '-') sgn = -1
+    if (text(j:j) == '+' .or. text(j:j) == '-') j = j + 1
+    do while (j <= n)
+       if (expo < 100000) expo = 10 * expo + (iachar(text(j:j)) - iachar('0'))
+       j = j + 1
+    end do
+    expo = sgn * expo
+  end function written_exponent
 
   pure logical function is_digit(c)
     character, intent(in) :: c

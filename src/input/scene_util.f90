@@ -11,6 +11,7 @@ module scene_util
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: data_line_t, keyword_block_t, upper_case, is_real_text
+  use keyword_numbers, only: written_exponent
   implicit none
   private
 
@@ -154,7 +155,7 @@ contains
   !> max_decimal_exponent (digits before the point plus the written exponent).
   pure logical function magnitude_ok(text)
     character(len=*), intent(in) :: text
-    integer :: k, n, int_digits, expo, sgn
+    integer :: k, n, int_digits, expo
     logical :: leading
 
     n = len_trim(text)
@@ -172,19 +173,7 @@ contains
        if (index('eEdD', text(k:k)) > 0) exit
        k = k + 1
     end do
-    expo = 0
-    if (k < n) then
-       k = k + 1
-       sgn = 1
-       if (text(k:k) == '-') sgn = -1
-       if (text(k:k) == '+' .or. text(k:k) == '-') k = k + 1
-       do while (k <= n)
-          ! clamp: a long exponent must not overflow the integer
-          if (expo < 100000) expo = 10 * expo + (iachar(text(k:k)) - iachar('0'))
-          k = k + 1
-       end do
-       expo = sgn * expo
-    end if
+    expo = written_exponent(text(1:n), k)
     magnitude_ok = expo + int_digits <= max_decimal_exponent
   end function magnitude_ok
 
