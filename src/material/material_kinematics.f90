@@ -1,13 +1,13 @@
-!> Kinematic arrays the driver hands to the VUMAT besides the strain increment.
+!> Kinematic arrays handed to a VUMAT besides the strain increment, for a material point
+!> driven by prescribed corotational strain increments and no rotation: the material-point
+!> driver's path and the door's two-point packaging probe (material_door).
 !>
-!> The material-point driver prescribes corotational strain increments directly and no
-!> rotation (relSpinInc = 0, R = I). It keeps the accumulated logarithmic strain E
-!> (sum of the increments, tensor shear) and reports stretch U = exp(E) and F = U. This is
-!> exact for coaxial paths (triaxial, biaxial, oedometer, isotropic); for simple shear it
-!> is the usual material-point idealisation (strain increments without spin), which is
-!> what the closed-form checks assume. Our VUMATs do not use U or F; user VUMATs that do
-!> get a consistent, symmetric pair.
-module matpoint_kinematics
+!> relSpinInc = 0, R = I. The accumulated logarithmic strain E (sum of the increments, tensor
+!> shear) gives the stretch U = exp(E) and F = U. This is exact for coaxial paths (triaxial,
+!> biaxial, oedometer, isotropic); for simple shear it is the usual material-point idealisation
+!> (strain increments without spin), which is what the closed-form checks assume. Our VUMATs do
+!> not use U or F; user VUMATs that do get a consistent, symmetric pair.
+module material_kinematics
   use material_kinds, only: dp
   implicit none
   private
@@ -128,4 +128,4 @@ contains
     end do
   end subroutine symmetric_eigen
 
-end module matpoint_kinematics
+end module material_kinematics
