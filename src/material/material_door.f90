@@ -274,11 +274,13 @@ contains
     character(len=*), intent(in) :: file
     type(error_t), intent(inout), optional :: err
     real(dp) :: modulus
+    character(len=16) :: value
 
     modulus = packaging_modulus(mat, ncomp, nshr)
     if (stiffness_ok(modulus)) return
+    write (value, '(es12.4)') modulus
     call refuse_stiffness(mat, file, 'a strain increment 1e-6 in direction 11', &
-         'the stiffness ' // real_text(modulus), 'a positive, finite elastic modulus', err)
+         'the stiffness ' // trim(adjustl(value)), 'a positive, finite elastic modulus', err)
   end function checked_packaging_modulus
 
   !> packaging_moduli, stopping (or recording in `err`) as checked_packaging_modulus does when
@@ -290,11 +292,14 @@ contains
     character(len=*), intent(in) :: file
     real(dp), intent(out) :: two_g, bulk
     type(error_t), intent(inout), optional :: err
+    character(len=16) :: shear, bulk_value
 
     call packaging_moduli(mat, ncomp, field, dt, two_g, bulk)
     if (stiffness_ok(two_g) .and. stiffness_ok(bulk)) return
+    write (shear, '(es12.4)') two_g
+    write (bulk_value, '(es12.4)') bulk
     call refuse_stiffness(mat, file, 'a volumetric strain increment -3e-6 and the same with a shear ' // &
-         '1e-7', '2G = ' // real_text(two_g) // ', K = ' // real_text(bulk), &
+         '1e-7', '2G = ' // trim(adjustl(shear)) // ', K = ' // trim(adjustl(bulk_value)), &
          'a positive, finite shear and bulk modulus', err)
   end subroutine checked_packaging_moduli
 
@@ -307,15 +312,6 @@ contains
     stiffness_ok = .false.
     if (ieee_is_finite(modulus)) stiffness_ok = modulus > 0
   end function stiffness_ok
-
-  function real_text(x) result(text)
-    real(dp), intent(in) :: x
-    character(len=:), allocatable :: text
-    character(len=32) :: buf
-
-    write (buf, '(es12.4)') x
-    text = trim(adjustl(buf))
-  end function real_text
 
   !> The packaging call's error: the material, where it is defined, the probe and the answer.
   subroutine refuse_stiffness(mat, file, probe, answer, expected, err)

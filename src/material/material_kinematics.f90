@@ -9,6 +9,7 @@
 !> not use U or F; user VUMATs that do get a consistent, symmetric pair.
 module material_kinematics
   use material_kinds, only: dp
+  use lapack_interfaces, only: dsyev
   implicit none
   private
 
@@ -25,7 +26,7 @@ contains
   end function volumetric_strain
 
   !> U = exp(E) in VUMAT layout (11,22,33,12[,23,31]).
-  pure subroutine stretch_from_log_strain(ncomp, e, u)
+  subroutine stretch_from_log_strain(ncomp, e, u)
     integer, intent(in) :: ncomp
     real(dp), intent(in) :: e(ncomp)
     real(dp), intent(out) :: u(ncomp)
@@ -75,57 +76,21 @@ contains
     end do
   end function outer
 
-  !> Eigenvalues w and eigenvectors v(:,k) of a symmetric 3x3 matrix (cyclic Jacobi;
-  !> converges to round-off in a handful of sweeps for 3x3).
-  pure subroutine symmetric_eigen(a_in, w, v)
+  !> Eigenvalues w and orthonormal eigenvectors v(:,k) of a symmetric 3x3 matrix (LAPACK dsyev;
+  !> called once per point and increment, not in a vectorised kernel). dsyev fails only on
+  !> non-finite input, which the caller never forms from finite strains; w is then NaN so the
+  !> VUMAT's non-finite check stops the run instead of going on with a wrong stretch.
+  subroutine symmetric_eigen(a_in, w, v)
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     real(dp), intent(in) :: a_in(3, 3)
     real(dp), intent(out) :: w(3), v(3, 3)
-    real(dp) :: a(3, 3), off, scale, theta, t, c, s, tau, apq, app, aqq
-    real(dp) :: ap(3), aq(3)
-    integer :: sweep, p, q, i, r
+    integer, parameter :: lwork = 102   ! (block size 32 + 2) * 3, dsyev's optimal for n = 3
+    real(dp) :: work(lwork)
+    integer :: info
 
-    a = a_in
-    v = 0.0_dp
-    do i = 1, 3
-       v(i, i) = 1.0_dp
-    end do
-    scale = max(maxval(abs(a)), tiny(1.0_dp))
-    do sweep = 1, 50
-       off = abs(a(1, 2)) + abs(a(1, 3)) + abs(a(2, 3))
-       if (off <= 1.0e-18_dp * scale) exit
-       do p = 1, 2
-          do q = p + 1, 3
-             apq = a(p, q)
-             if (abs(apq) <= 1.0e-300_dp) cycle
-             app = a(p, p); aqq = a(q, q)
-             theta = (aqq - app) / (2.0_dp * apq)
-             if (abs(theta) > 1.0e100_dp) then
-                ! theta**2 would overflow; t -> 1/(2 theta)
-                t = 0.5_dp / theta
-             else
-                t = sign(1.0_dp, theta) / (abs(theta) + sqrt(theta * theta + 1.0_dp))
-             end if
-             c = 1.0_dp / sqrt(t * t + 1.0_dp)
-             s = t * c
-             tau = s / (1.0_dp + c)
-             ap = a(:, p); aq = a(:, q)
-             do r = 1, 3
-                a(r, p) = ap(r) - s * (aq(r) + tau * ap(r))
-                a(r, q) = aq(r) + s * (ap(r) - tau * aq(r))
-             end do
-             a(p, :) = a(:, p); a(q, :) = a(:, q)
-             a(p, p) = app - t * apq
-             a(q, q) = aqq + t * apq
-             a(p, q) = 0.0_dp; a(q, p) = 0.0_dp
-             ap = v(:, p); aq = v(:, q)
-             v(:, p) = ap - s * (aq + tau * ap)
-             v(:, q) = aq + s * (ap - tau * aq)
-          end do
-       end do
-    end do
-    do i = 1, 3
-       w(i) = a(i, i)
-    end do
+    v = a_in
+    call dsyev('V', 'U', 3, v, 3, w, work, lwork, info)
+    if (info /= 0) w = ieee_value(1.0_dp, ieee_quiet_nan)
   end subroutine symmetric_eigen
 
 end module material_kinematics
