@@ -388,7 +388,7 @@ BROKEN = """      subroutine vumat(nblock, ndir)
       x = = 1
       end
 """
-NO_VUMAT = """      subroutine vusdfld(nblock)
+NO_VUMAT = """      subroutine vumat_helper(nblock)
       include 'vaba_param.inc'
       return
       end
