@@ -212,7 +212,8 @@ def main() -> int:
         check = case['check'](case['props']) if 'props' in case else None
         for host in ('cpe4r', 'c3d8r', 'mpm3d', 'matpoint'):
             if host not in case['hosts']:
-                print(f'  {host:9s} skipped ({"particles write no FV; the driver keeps its own door" if check is None else "the file does not serve it"})')
+                why = {'mpm3d': 'particles write no FV', 'matpoint': 'the driver keeps its own VUSDFLD door'}
+                print(f'  {host:9s} skipped ({why[host] if check is None else "the file does not serve it"})')
                 continue
             try:
                 work = a.work / name / host
