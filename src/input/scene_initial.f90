@@ -16,7 +16,7 @@ module scene_initial
   use model, only: model_t, initial_velocity_t, initial_stress_t, initial_field_t
   use scene_layout, only: scene_layout_t
   use scene_sets, only: node_targets, elem_targets
-  use scene_temperature, only: material_target
+  use scene_temperature, only: predefined_line
   use scene_util, only: itoa, get_real, get_int, expect_fields, expect_lines
   implicit none
   private
@@ -149,16 +149,7 @@ contains
     end if
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
-         if (model%mesh%n_nodes == 0) then
-            ! material-point scene: the particles of a material
-            call expect_fields(blk, dl, 2, 2, 'material name (its particles), value', err)
-            if (.not. err%raised) call material_target(model, dl, 1, entry%material, err)
-            if (.not. allocated(entry%nodes)) allocate (entry%nodes(0))
-         else
-            call expect_fields(blk, dl, 2, 2, 'node or node set, value', err)
-            if (.not. err%raised) call node_targets(model, dl, 1, entry%nodes, err)
-         end if
-         if (.not. err%raised) call get_real(dl, 2, entry%value, err)
+         call predefined_line(blk, dl, model, 'value', entry%nodes, entry%material, entry%value, err)
          if (err%raised) return
          model%initial_fields = [model%initial_fields, entry]
        end associate

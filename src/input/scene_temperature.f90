@@ -21,7 +21,7 @@ module scene_temperature
   implicit none
   private
 
-  public :: read_temperature, material_target
+  public :: read_temperature, predefined_line
 
 contains
 
@@ -36,7 +36,6 @@ contains
     type(temperature_t) :: entry
     character(len=:), allocatable :: op
     integer :: il, amp
-    logical :: mpm
 
     call blk%check_params([character(len=9) :: 'AMPLITUDE', 'OP'], err)
     if (.not. err%raised) call blk%get_string('OP', op, err, default='MOD', choices=[character(len=3) :: 'MOD', 'NEW'])
@@ -44,29 +43,44 @@ contains
     if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'temperatures', err)
     if (err%raised) return
     if (op == 'NEW') n = 0
-    mpm = model%mesh%n_nodes == 0
     if (.not. allocated(active)) allocate (active(0))
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
-         if (mpm) then
-            call expect_fields(blk, dl, 2, 2, 'material name (its particles), temperature', err)
-            if (.not. err%raised) call material_target(model, dl, 1, entry%material, err)
-            allocate (entry%nodes(0))
-         else
-            call expect_fields(blk, dl, 2, 2, 'node or node set, temperature', err)
-            if (.not. err%raised) call node_targets(model, dl, 1, entry%nodes, err)
-         end if
-         if (.not. err%raised) call get_real(dl, 2, entry%value, err)
+         call predefined_line(blk, dl, model, 'temperature', entry%nodes, entry%material, entry%value, err)
          if (err%raised) return
          entry%variation%amplitude = amp
          entry%source = where_text(dl%file, dl%line)
          if (n == size(active)) active = [active, entry]
          n = n + 1
          active(n) = entry
-         deallocate (entry%nodes)
        end associate
     end do
   end subroutine read_temperature
+
+  !> A data line `target, value` of a predefined field: target = node or node set (nodes), or in a
+  !> material-point scene (no mesh) a material name (material, nodes empty).
+  subroutine predefined_line(blk, dl, model, what, nodes, material, value, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(data_line_t), intent(in) :: dl
+    type(model_t), intent(in) :: model
+    character(len=*), intent(in) :: what
+    integer, allocatable, intent(out) :: nodes(:)
+    integer, intent(out) :: material
+    real(dp), intent(out) :: value
+    type(error_t), intent(inout) :: err
+
+    material = 0
+    value = 0
+    if (model%mesh%n_nodes == 0) then
+       allocate (nodes(0))
+       call expect_fields(blk, dl, 2, 2, 'material name (its particles), ' // what, err)
+       if (.not. err%raised) call material_target(model, dl, 1, material, err)
+    else
+       call expect_fields(blk, dl, 2, 2, 'node or node set, ' // what, err)
+       if (.not. err%raised) call node_targets(model, dl, 1, nodes, err)
+    end if
+    if (.not. err%raised) call get_real(dl, 2, value, err)
+  end subroutine predefined_line
 
   !> Field `i` of `dl` names a material (MPM scenes: predefined fields are given per material's
   !> particles); `k` is its index.
