@@ -225,8 +225,9 @@ contains
     m%props = mat%user_props
     ! With a user file every *USER MATERIAL is the user's, whatever its name (Abaqus's rule);
     ! our models stay reachable from it through bulkflow_vumat.
-    ! A user file with only a VUSDFLD leaves *USER MATERIAL to our VUMATs.
-    m%user_code = user_subroutine .and. associated(user_vumat)
+    ! A user file with only a VUSDFLD (its vusdfld loaded, no vumat) leaves *USER MATERIAL to
+    ! our VUMATs.
+    m%user_code = user_subroutine .and. (associated(user_vumat) .or. .not. associated(user_vusdfld))
     if (m%user_code) return
     ! Without a user's subroutine our VUMAT will receive the name: check it now.
     if (model_from_name(m%vumat_name) == model_unknown) then
