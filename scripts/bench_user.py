@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """What loading the material at run time costs: --user (our single Abaqus file, compiled and
 loaded with dlopen) against --user-linked (the same VUMAT linked into the executable), on the
-same scenes, the same user path through the host. Runs alternate (linked, loaded, linked, ...)
+same scenes, the same user path through the host. Runs alternate (linked, loaded, loaded, linked, ...)
 so that a busy machine slows both alike; the figure is the median of the time-loop seconds
 the solver reports (element scenes: the 'total' of the timing table; MPM: 'time loop').
 
     python3 scripts/bench_user.py [--build build] [--repeats 5] [--n-across 60]
 
-Prints per scene the two medians and the ratio loaded/linked (target: within 1.02).
+Prints per scene the two medians, the ratio loaded/linked (target: within 1.02), the median of
+the per-pair ratios, and the load average before and after (a shared machine: read the ratios
+against it).
 """
 from __future__ import annotations
 
@@ -41,6 +43,14 @@ def run(cmd: list[str], cwd: Path, env: dict) -> float:
     return loop_seconds(proc.stdout)
 
 
+def load_average() -> str:
+    """The 1-, 5- and 15-minute load averages (the machine may be shared)."""
+    try:
+        return ' '.join(Path('/proc/loadavg').read_text().split()[:3])
+    except OSError:
+        return 'unknown'
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument('--build', type=Path, default=REPO / 'build')
@@ -62,19 +72,24 @@ def main() -> int:
     # Compile once before timing (the cache then serves every run).
     subprocess.run([str(bulkflow), str(scenes[1][1]), '--check', '--user', str(single)], cwd=work, env=env,
                    check=True, capture_output=True)
-    print(f'bench_user: {bulkflow}, {a.repeats} alternated runs each, median time-loop seconds')
+    print(f'bench_user: {bulkflow}, {a.repeats} alternated runs each, median time-loop seconds; '
+          f'load average {load_average()} at the start')
     worst = 0.0
     for name, scene in scenes:
         linked, loaded = [], []
-        for _ in range(a.repeats):
-            linked.append(run([str(bulkflow), str(scene), '--output', 'linked', '--user-linked'], work, env))
-            loaded.append(run([str(bulkflow), str(scene), '--output', 'loaded', '--user', str(single)], work, env))
+        for k in range(a.repeats):
+            # alternate which goes first, so a load that drifts within a pair favours neither
+            pair = [('linked', ['--user-linked']), ('loaded', ['--user', str(single)])]
+            for kind, extra in (pair if k % 2 == 0 else pair[::-1]):
+                seconds = run([str(bulkflow), str(scene), '--output', kind] + extra, work, env)
+                (linked if kind == 'linked' else loaded).append(seconds)
         ml, mo = statistics.median(linked), statistics.median(loaded)
         ratio = mo / ml
+        pairwise = statistics.median(o / l for o, l in zip(loaded, linked))
         worst = max(worst, ratio)
         print(f'  {name:32s} linked {ml:8.3f} s   loaded {mo:8.3f} s   ratio {ratio:6.3f}'
-              f'   (min {min(linked):.3f} / {min(loaded):.3f})')
-    print(f'  largest ratio loaded/linked: {worst:.3f} (target <= 1.02)')
+              f'   (min {min(linked):.3f} / {min(loaded):.3f}; median of pair ratios {pairwise:.3f})')
+    print(f'  largest ratio loaded/linked: {worst:.3f} (target <= 1.02); load average {load_average()} at the end')
     return 0
 
 

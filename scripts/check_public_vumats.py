@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Run public third-party VUMATs/VUSDFLDs, unchanged, with --user in the four hosts and check
-each against a closed form (docs/user_subroutines.md lists the files and the results).
+each against a closed form (docs/user_subroutines.md lists the files and the results). A file
+with only a VUSDFLD runs on our *MOHR COULOMB in CPE4R and C3D8R (its fields against the closed
+form of what it should write from the stress it reads).
 
 The files are not part of bulkflow: download them first (their repositories are listed in
 CASES below and in the docs), into one folder, under the names CASES gives, e.g.
@@ -30,6 +32,9 @@ REPO = Path(__file__).resolve().parent.parent
 spec = importlib.util.spec_from_file_location('user_checks', REPO / 'tests' / 'user' / 'check_user_subroutines.py')
 uc = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(uc)
+spec = importlib.util.spec_from_file_location('vusdfld_builtin', REPO / 'tests' / 'user' / 'check_vusdfld_builtin.py')
+vb = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(vb)
 
 
 def jc_check(props):
@@ -67,6 +72,14 @@ def ice_check(props):
     return check
 
 
+def ice_vusdfld_check(fields, stress6):
+    """NTNU ice VUSDFLD: field 1 = eps0 + (p/(M P2) - N/M)^2 with its constants eps0 = 0.01,
+    P2 = 53.2429898, M = 1, N = 0.75 (p = -tr(sigma)/3 in MPa, from vgetvrm('S') at the start of
+    the increment); field 2 = 1 while p > Pcut = -2. Returns (got, want) pairs."""
+    p = -sum(stress6[:3]) / 3
+    return [(fields[0], 0.01 + (p / 53.2429898 - 0.75) ** 2), (fields[1], 1.0 if p > -2.0 else 0.0)]
+
+
 # name -> (repository, path in it, file name in --dir, props, depvar, kinds of host, check, comment)
 CASES = {
     'johnson_cook': dict(
@@ -86,7 +99,28 @@ CASES = {
         # after its 200 iterations without reaching the surface in large increments
         strain=-0.004,
         what='pressure-dependent (Tsai-Wu) plasticity of ice, single-precision locals'),
+    'ice_vusdfld': dict(
+        repo='NTNU-IMT/Ice-Elastoplastic-Material-Model', path='src/VUSDFLD.for', file='ntnu_imt_VUSDFLD.for',
+        # a VUSDFLD only: on our *MOHR COULOMB (MPa: E, nu; phi, psi; c), which has the PEEQ it reads
+        vusdfld=dict(e=9500.0, nu=0.3, c=1.0, density=9.0e-4, strain=-0.004, angles='30., 0.', fields=2),
+        hosts=['cpe4r', 'c3d8r'], check=ice_vusdfld_check, tol=1e-6,
+        what='VUSDFLD (failure strain from the pressure, read with vgetvrm S and PEEQ) on our *MOHR COULOMB; '
+             'single-precision locals'),
 }
+
+
+def host_vusdfld(case, user_file, work: Path, ndim: int):
+    """A VUSDFLD-only file on our built-in material: one element compressed and held, so the
+    start-of-increment stress the VUSDFLD reads is the final one; its fields are FV1.. of the frames."""
+    work.mkdir(parents=True, exist_ok=True)
+    scene = work / 'builtin.inp'
+    scene.write_text(vb.scene_text(ndim, **case['vusdfld']))
+    run([str(BULKFLOW), str(scene), '--quiet', '--user', str(user_file)], work)
+    fr = uc.last_frame(work / 'builtin.h5', 'frames')
+    s = list(fr['S'][0])
+    s6 = s if len(s) == 6 else [s[0], s[1], s[2], s[3], 0.0, 0.0]
+    fields = [float(fr[f'FV{j}'][0]) for j in range(1, case['vusdfld']['fields'] + 1)]
+    return case['check'](fields, s6)
 
 
 def run(cmd, cwd):
@@ -175,14 +209,20 @@ def main() -> int:
             print(f'  missing {user_file}: download it first')
             failures += 1
             continue
-        check = case['check'](case['props'])
+        check = case['check'](case['props']) if 'props' in case else None
         for host in ('cpe4r', 'c3d8r', 'mpm3d', 'matpoint'):
             if host not in case['hosts']:
-                print(f'  {host:9s} skipped (the file does not serve it)')
+                why = {'mpm3d': 'particles write no FV', 'matpoint': 'the driver keeps its own VUSDFLD door'}
+                print(f'  {host:9s} skipped ({why[host] if check is None else "the file does not serve it"})')
                 continue
             try:
                 work = a.work / name / host
-                if host == 'mpm3d':
+                if check is None:
+                    pairs = host_vusdfld(case, user_file, work, 2 if host == 'cpe4r' else 3)
+                    ok = all(abs(g - w) <= case['tol'] * max(1.0, abs(w)) for g, w in pairs)
+                    print(f'  {host:9s} fields ' + ', '.join(f'{g:.9e} (closed form {w:.9e})' for g, w in pairs)
+                          + f' {"OK" if ok else "FAILED"}')
+                elif host == 'mpm3d':
                     err, tol = host_mpm3d(case, user_file, work)
                     ok = err <= tol
                     print(f'  {host:9s} sigma_yy vs -rho g (H - y): max error {err:.3e} (limit {tol:.1e})'

@@ -13,6 +13,7 @@ module driver_elements
   use driver_solver, only: solver_t, element_block_t
   use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
        effect_bulk_viscosity, effect_user_field, effect_assembly
+  use driver_temperature, only: element_temperatures
   use material_door, only: vumat_work_t, call_material, vumat_work_init
   use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_internal_force_bv, &
        cpe4r_hourglass_update
@@ -362,9 +363,10 @@ contains
        end if
        call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
        call centroids(nb, nd, ne, w%xe_old, w%du, w%vumat%coord)
-       ! constant in time: *INITIAL CONDITIONS, TYPE=TEMPERATURE
-       w%vumat%temp(1:nb) = blk%temp
-       w%vumat%temp_new(1:nb) = blk%temp
+       ! *INITIAL CONDITIONS, TYPE=TEMPERATURE and the step's *TEMPERATURE at t_n and t_n+1
+       call element_temperatures(m, solver, blk, solver%step_time, solver%total_time, w%vumat%temp(1:nb))
+       call element_temperatures(m, solver, blk, solver%step_time + dt, solver%total_time + dt, &
+            w%vumat%temp_new(1:nb))
     end if
 
     ! PE (only when written): Δε^p = Δε − C⁻¹(σ_new − σ_old); the σ_old part before the call.

@@ -328,14 +328,23 @@ contains
           deallocate(values)
        end do
     case ('FV')
-       allocate(values(n, 1))
-       values = 0
+       ! FV1..FVn: every field variable any block has (a VUSDFLD with FIELDS=n writes n).
+       ns = 1
        do ib = 1, solver%n_blocks
-          associate (b => solver%blocks(ib))
-            values(b%first:b%first + b%count - 1, 1) = b%field(:, 1)
-          end associate
+          ns = max(ns, size(solver%blocks(ib)%field, 2))
        end do
-       call field_writer_element_field(out%fields, 'FV1', solver%part%elem_global, values)
+       do j = 1, ns
+          allocate(values(n, 1))
+          values = 0
+          do ib = 1, solver%n_blocks
+             associate (b => solver%blocks(ib))
+               if (j <= size(b%field, 2)) values(b%first:b%first + b%count - 1, 1) = b%field(:, j)
+             end associate
+          end do
+          write (label, '(a,i0)') 'FV', j
+          call field_writer_element_field(out%fields, trim(label), solver%part%elem_global, values)
+          deallocate(values)
+       end do
     case ('STATUS')
        allocate(values(n, 1))
        values = 1

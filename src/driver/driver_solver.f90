@@ -32,7 +32,11 @@ module driver_solver
      real(dp), allocatable :: stress(:, :)            !< corotational Cauchy stress at t_n
      real(dp), allocatable :: state(:, :)             !< (count, nstatev) SDVs at t_n
      real(dp), allocatable :: field(:, :)             !< (count, nfieldv) field variables at t_n
-     real(dp), allocatable :: temp(:)                 !< (count) temperature (user VUMATs' tempOld/New)
+     real(dp), allocatable :: temp(:)                 !< (count) initial temperature (user VUMATs)
+     !> The temperature in the step temp_step: temp_base + Σ_j temp_coef(:, j) a_j(t) over the
+     !> step's *TEMPERATURE entries (driver_temperature).
+     real(dp), allocatable :: temp_base(:), temp_coef(:, :)
+     integer :: temp_step = 0
      real(dp), allocatable :: e_int(:), e_inel(:)     !< specific energies (per unit mass)
      real(dp), allocatable :: log_strain(:, :)        !< accumulated corotational strain (LE)
      real(dp), allocatable :: plastic_strain(:, :)    !< corotational plastic strain (PE); (0, ncomp) unless written

@@ -7,7 +7,8 @@
 !> VUMAT order 11, 22, 33, 12, 23, 31, so s13 goes to slot 6 and s23 to slot 5.
 !> VELOCITY: node or node set, dof, value. FIELD, VARIABLE=n (default 1): node or node set,
 !> value. TEMPERATURE: node or node set, value (the temperature a VUMAT receives as
-!> tempOld/tempNew, constant in time).
+!> tempOld/tempNew until a step's *TEMPERATURE changes it). In material-point scenes only FIELD
+!> and TEMPERATURE, on the particles of a material (`material name, value`).
 module scene_initial
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
@@ -15,6 +16,7 @@ module scene_initial
   use model, only: model_t, initial_velocity_t, initial_stress_t, initial_field_t
   use scene_layout, only: scene_layout_t
   use scene_sets, only: node_targets, elem_targets
+  use scene_temperature, only: predefined_line
   use scene_util, only: itoa, get_real, get_int, expect_fields, expect_lines
   implicit none
   private
@@ -52,6 +54,11 @@ contains
          end if
          call expect_lines(blk, 1, huge(1), 'initial values', err)
          if (err%raised) return
+         if (model%mesh%n_nodes == 0 .and. ctype /= 'FIELD' .and. ctype /= 'TEMPERATURE') then
+            call blk%fail('*INITIAL CONDITIONS, TYPE=' // ctype // ' in a material-point scene; expected ' // &
+                 'TYPE=TEMPERATURE or FIELD (particles start at rest and stress free)', err)
+            return
+         end if
          select case (ctype)
          case ('STRESS')
             call read_stress(blk, model, err)
@@ -142,9 +149,7 @@ contains
     end if
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
-         call expect_fields(blk, dl, 2, 2, 'node or node set, value', err)
-         if (.not. err%raised) call node_targets(model, dl, 1, entry%nodes, err)
-         if (.not. err%raised) call get_real(dl, 2, entry%value, err)
+         call predefined_line(blk, dl, model, 'value', entry%nodes, entry%material, entry%value, err)
          if (err%raised) return
          model%initial_fields = [model%initial_fields, entry]
        end associate

@@ -188,7 +188,7 @@ contains
 
     kind = ' '
     select case (blk%name)
-    case ('BOUNDARY', 'CLOAD')
+    case ('BOUNDARY', 'CLOAD', 'TEMPERATURE')
        kind = 'N'
     case ('DLOAD')
        kind = 'E'

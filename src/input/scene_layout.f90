@@ -46,7 +46,7 @@ contains
          'MPM GRID', 'PARTICLES', 'OUTFLOW')
        keyword_kind = kw_model
     case ('DYNAMIC', 'DLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'FIXED MASS SCALING', &
-          'STOP CONDITION', 'INFLOW')
+          'STOP CONDITION', 'INFLOW', 'TEMPERATURE')
        keyword_kind = kw_step_only
     case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR', 'MPM CONTROLS', 'MPM WALL')
        keyword_kind = kw_anywhere

@@ -22,7 +22,7 @@ module scene_materials
        opt_dp_hardening, opt_user_material, opt_depvar, opt_user_field, opt_flow_function, &
        dp_hardening_shear, dp_hardening_tension
   use scene_util, only: rtoa, where_text, expect_lines, check_name
-  use user_library, only: user_vusdfld, user_library_name
+  use user_library, only: user_vumat, user_vusdfld, user_library_name
   implicit none
   private
 
@@ -253,12 +253,20 @@ contains
     m%props = mat%user_props
     ! With a user file every *USER MATERIAL is the user's, whatever its name (Abaqus's rule);
     ! our models stay reachable from it through bulkflow_vumat.
-    m%user_code = user_subroutine
-    if (user_subroutine) return
+    ! A user file with only a VUSDFLD (its vusdfld loaded, no vumat) leaves *USER MATERIAL to
+    ! our VUMATs.
+    m%user_code = user_subroutine .and. (associated(user_vumat) .or. .not. associated(user_vusdfld))
+    if (m%user_code) return
     ! Without a user's subroutine our VUMAT will receive the name: check it now.
     if (model_from_name(m%vumat_name) == model_unknown) then
-       call deck%blocks(mat%block)%fail('user material ' // trim(mat%name) // ' is not one of ' // &
-            'our VUMATs and no user subroutine is in use; expected ' // model_names_help(), err)
+       if (user_subroutine) then
+          call deck%blocks(mat%block)%fail('user material ' // trim(mat%name) // ' is not one of ' // &
+               'our VUMATs and the user file ' // user_library_name() // ' defines no VUMAT (only a ' // &
+               'VUSDFLD); expected SUBROUTINE VUMAT in it or ' // model_names_help(), err)
+       else
+          call deck%blocks(mat%block)%fail('user material ' // trim(mat%name) // ' is not one of ' // &
+               'our VUMATs and no user subroutine is in use; expected ' // model_names_help(), err)
+       end if
        return
     end if
     call final_check(deck%blocks(mat%option_block(opt_user_material)), m, err)
@@ -311,8 +319,9 @@ contains
     call move_alloc(p, m%props)
     m%nstatev = max(m%nstatev, n_state_plastic)
     if (n_ang > 0) then
-       ! the angle table runs on field 1, which our VUSDFLD sets to the volumetric strain
-       m%nfieldv = 1
+       ! the angle table runs on field 1, which our VUSDFLD sets to the volumetric strain (a
+       ! user's VUSDFLD may write more: *USER DEFINED FIELD, FIELDS=n)
+       m%nfieldv = max(1, m%nfieldv)
        m%user_field = .true.
     end if
     ! A cut-off above the apex of the cone c*cot(phi) would never be reached; only the

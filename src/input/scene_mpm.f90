@@ -74,8 +74,7 @@ contains
          else
             select case (blk%name)
             case ('NODE', 'ELEMENT', 'NSET', 'ELSET', 'SOLID SECTION', 'SECTION CONTROLS', 'SURFACE', &
-                 'RIGID BODY', 'SURFACE INTERACTION', 'FRICTION', 'CONTACT PAIR', 'BOUNDARY', &
-                 'INITIAL CONDITIONS')
+                 'RIGID BODY', 'SURFACE INTERACTION', 'FRICTION', 'CONTACT PAIR', 'BOUNDARY')
                call blk%fail('*' // blk%name // ' in a material-point scene (*MPM GRID at ' // &
                     where_text(deck%blocks(grid_block)%file, deck%blocks(grid_block)%line) // &
                     '); expected MPM keywords (*PARTICLES, *MPM WALL, ...): meshes and MPM do not mix yet', err)

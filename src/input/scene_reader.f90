@@ -81,6 +81,10 @@ contains
        if (err%raised) return
        call build_mpm(deck, layout, grid_block, model, err)
        if (err%raised) return
+       ! predefined fields on the particles of a material (TEMPERATURE, FIELD only)
+       call build_initial_conditions(deck, layout, model, err)
+       if (err%raised) return
+       call count_user_fields(model)
        call build_steps(deck, layout, model, err)
        if (.not. err%raised) call refuse_frequency(deck, err)
        return

@@ -1,4 +1,4 @@
-!> Steps: *STEP ... *END STEP with *DYNAMIC, EXPLICIT, *BOUNDARY, *DLOAD (GRAV),
+!> Steps: *STEP ... *END STEP with *DYNAMIC, EXPLICIT, *BOUNDARY, *DLOAD (GRAV), *TEMPERATURE,
 !> *CONTACT PAIR, *BULK VISCOSITY, *OUTPUT and *RESTART, resolved into a complete
 !> `step_t` each, following Abaqus's propagation rules:
 !>
@@ -24,7 +24,8 @@ module scene_steps
   use model, only: model_t
   use model_sets, only: find_set, name_length
   use model_steps, only: step_t, gravity_t, contact_pair_t, mass_scaling_t, mass_scaling_below_min, &
-       mass_scaling_uniform
+       mass_scaling_uniform, temperature_t
+  use scene_temperature, only: read_temperature
   use scene_layout, only: scene_layout_t
   use scene_amplitudes, only: amplitude_param
   use scene_boundaries, only: bc_state_t, bc_init, bc_clear, read_boundary, bc_resolve, boundary_op, &
@@ -55,6 +56,8 @@ module scene_steps
      real(dp) :: restart_time = 0
      integer :: n_mass_scaling = 0
      type(mass_scaling_t), allocatable :: mass_scaling(:)
+     integer :: n_temperatures = 0
+     type(temperature_t), allocatable :: temperatures(:)
   end type carry_t
 
 contains
@@ -69,7 +72,7 @@ contains
     real(dp) :: step_end
 
     call bc_init(c%bcs, model%mesh%n_nodes)
-    allocate (c%gravity(0), c%pairs(0), c%mass_scaling(0))
+    allocate (c%gravity(0), c%pairs(0), c%mass_scaling(0), c%temperatures(0))
     do i = 1, deck%n_blocks
        if (layout%step_of(i) /= 0) cycle
        select case (deck%blocks(i)%name)
@@ -96,6 +99,10 @@ contains
           call bc_carry(c%bcs, model%amplitudes, model%steps(s - 1)%period, step_end)
           do k = 1, c%n_gravity
              call carry_into_step(c%gravity(k)%variation, model%amplitudes, model%steps(s - 1)%period, &
+                  step_end)
+          end do
+          do k = 1, c%n_temperatures
+             call carry_into_step(c%temperatures(k)%variation, model%amplitudes, model%steps(s - 1)%period, &
                   step_end)
           end do
        end if
@@ -161,6 +168,8 @@ contains
             call read_boundary(blk, model, .true., c%bcs, err)
          case ('DLOAD')
             call read_dload(blk, model, c, err)
+         case ('TEMPERATURE')
+            call read_temperature(blk, model, c%temperatures, c%n_temperatures, err)
          case ('CONTACT PAIR')
             call read_contact_pair(blk, model, .true., c, err)
          case ('BULK VISCOSITY')
@@ -213,6 +222,7 @@ contains
     call bc_resolve(c%bcs, step%boundaries)
     step%mass_scaling = c%mass_scaling(1:c%n_mass_scaling)
     step%gravity = c%gravity(1:c%n_gravity)
+    step%temperatures = c%temperatures(1:c%n_temperatures)
     step%contact_pairs = c%pairs(1:c%n_pairs)
     step%field_outputs = c%outputs%field(1:c%outputs%n_field)
     step%history_outputs = c%outputs%history(1:c%outputs%n_history)

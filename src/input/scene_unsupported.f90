@@ -34,7 +34,7 @@ contains
          'SOLID SECTION COMPOSITE', 'INFINITE SECTION', 'TRUSS SECTION', 'ORIENTATION', 'NORMAL', 'TRANSFORM', &
          'SYSTEM', 'HOURGLASS STIFFNESS', 'TRANSVERSE SHEAR STIFFNESS')
        hint = 'bulkflow has continuum elements only (CPE4R, C3D8R, *SOLID SECTION) in global axes'
-    case ('CLOAD', 'DSLOAD', 'CFLUX', 'DFLUX', 'DSFLUX', 'FILM', 'SFILM', 'RADIATE', 'TEMPERATURE', 'FIELD', &
+    case ('CLOAD', 'DSLOAD', 'CFLUX', 'DFLUX', 'DSFLUX', 'FILM', 'SFILM', 'RADIATE', 'FIELD', &
          'CONNECTOR LOAD', 'CONNECTOR MOTION', 'BASE MOTION', 'INERTIA RELIEF', 'PRESSURE STRESS', 'DSECURRENT', &
          'CECHARGE', 'DECHARGE', 'CSLOAD', 'CORRELATION', 'MOTION', 'CHANGE FRICTION', 'MODEL CHANGE')
        hint = 'bulkflow offers gravity (*DLOAD, GRAV), prescribed displacements and velocities (*BOUNDARY) ' // &

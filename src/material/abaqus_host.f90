@@ -3,7 +3,8 @@
 !> Abaqus's `vgetvrm` takes no argument naming the block, so the host must say beforehand
 !> which block is current: `host_set_block` copies its start-of-increment stress and
 !> logarithmic strain (VUMAT layout, `(nblock, ncomp)`), and `host_set_block_extra` its state
-!> variables, temperature and, for our plastic models, plastic strain and PEEQ; the external
+!> variables, temperature and, for our plastic models, plastic strain and PEEQ, and
+!> `host_set_block_moduli` the material's isotropic moduli (PE = LE − C⁻¹:σ for any material); the external
 !> `vgetvrm` reads them back in Abaqus's flat layout (docs/user_subroutines.md lists the keys).
 !> A key whose values the current block does not have is an error that names the key and the
 !> keys the block has (`host_available_keys`): user code that ignores jStatus would otherwise
@@ -25,12 +26,15 @@ module abaqus_host
   real(dp), allocatable :: block_stress(:, :), block_log_strain(:, :)
   real(dp), allocatable :: block_state(:, :), block_temp(:), block_plastic(:, :), block_peeq(:)
   integer :: block_size = 0, block_components = 0
+  !> Isotropic moduli λ, G of the current block's material (packaging call); < 0: not known.
+  real(dp) :: block_lambda = -1, block_shear = -1
   procedure(exit_handler), pointer :: on_exit => null()
   character(len=:), allocatable :: job_name, output_dir
   integer :: job_rank = 0, job_ranks = 1
 
   public :: exit_handler
-  public :: host_set_block, host_set_block_extra, host_get_variable, host_set_exit_handler, host_exit
+  public :: host_set_block, host_set_block_extra, host_set_block_moduli, host_get_variable
+  public :: host_set_exit_handler, host_exit
   public :: host_available_keys
   public :: host_set_job, host_job_name, host_output_dir, host_rank, host_ranks
 
@@ -54,7 +58,17 @@ contains
     if (allocated(block_temp)) deallocate(block_temp)
     if (allocated(block_plastic)) deallocate(block_plastic)
     if (allocated(block_peeq)) deallocate(block_peeq)
+    block_lambda = -1
+    block_shear = -1
   end subroutine host_set_block
+
+  !> The isotropic elastic moduli of the current block's material (its packaging call): with them
+  !> vgetvrm('PE') answers LE − C⁻¹:σ when the block keeps no plastic strain of its own.
+  subroutine host_set_block_moduli(lambda, shear)
+    real(dp), intent(in) :: lambda, shear
+    block_lambda = lambda
+    block_shear = shear
+  end subroutine host_set_block_moduli
 
   !> Further start-of-increment values of the current block (after host_set_block): state
   !> variables (SDV), temperature (TEMP), and when the material has them plastic strain (PE)
@@ -92,8 +106,12 @@ contains
        if (.not. allocated(block_temp)) return
        values(1:block_size) = block_temp
     case ('PE')
-       if (.not. allocated(block_plastic)) return
-       call put(block_plastic)
+       if (allocated(block_plastic)) then
+          call put(block_plastic)
+       else
+          if (block_shear <= 0 .or. 3 * block_lambda + 2 * block_shear <= 0) return
+          call put(plastic_from_moduli())
+       end if
     case ('PEEQ')
        if (.not. allocated(block_peeq)) return
        values(1:block_size) = block_peeq
@@ -102,6 +120,17 @@ contains
     end select
     status = 0
   contains
+    !> LE − C⁻¹:σ for isotropic C (λ, G): ε_e = σ/(2G) − λ tr σ/(2G (3λ + 2G)) I, tensor shears.
+    function plastic_from_moduli() result(pe)
+      real(dp) :: pe(block_size, block_components), trace(block_size)
+      integer :: j
+      trace = block_stress(1:block_size, 1) + block_stress(1:block_size, 2) + block_stress(1:block_size, 3)
+      do j = 1, block_components
+         pe(:, j) = block_log_strain(1:block_size, j) - block_stress(1:block_size, j) / (2 * block_shear)
+         if (j <= 3) pe(:, j) = pe(:, j) + block_lambda * trace / (2 * block_shear * (3 * block_lambda + &
+              2 * block_shear))
+      end do
+    end function plastic_from_moduli
     subroutine put(a)
       real(dp), intent(in) :: a(:, :)
       integer :: j
@@ -123,7 +152,7 @@ contains
     keys = 'S, LE'
     if (allocated(block_state)) keys = keys // ', SDV'
     if (allocated(block_temp)) keys = keys // ', TEMP'
-    if (allocated(block_plastic)) keys = keys // ', PE'
+    if (allocated(block_plastic) .or. block_shear > 0) keys = keys // ', PE'
     if (allocated(block_peeq)) keys = keys // ', PEEQ'
   end function host_available_keys
 

@@ -6,8 +6,9 @@
 ! with --user finds them (src/material/user_library.f90).
 
 !> Start-of-increment values of an output variable for the current block.
-!> Keys: S, LE, SDV, TEMP, and PE, PEEQ for our plastic models. Any other key, or PE/PEEQ for a
-!> material that has none (a user's VUMAT), stops the run naming the key (exit 2): Abaqus
+!> Keys: S, LE, SDV, TEMP, PE (LE − C⁻¹:σ with the packaging call's moduli) and PEEQ for our
+!> plastic models. Any other key, or PEEQ for a material that has none (a user's VUMAT), stops
+!> the run naming the key (exit 2): Abaqus
 !> returns jStatus /= 0, but user code that does not test it would go on with stale data.
 subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
   use, intrinsic :: iso_fortran_env, only: error_unit
@@ -26,7 +27,7 @@ subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
   if (jStatus /= 0) then
      write (error_unit, '(a)') "bulkflow: error: user subroutine called vgetvrm('" // trim(adjustl(cVar)) // &
           "'): output variable not available for this material; it provides " // host_available_keys() // &
-          ' (PE and PEEQ only for our plastic models, a user VUMAT keeps none)'
+          ' (PEEQ only for our plastic models, a user VUMAT keeps none)'
      call host_exit(2)
   end if
 end subroutine vgetvrm

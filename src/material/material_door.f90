@@ -22,8 +22,9 @@
 module material_door
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use abaqus_host, only: host_set_block, host_set_block_extra
+  use abaqus_host, only: host_set_block, host_set_block_extra, host_set_block_moduli
   use model_materials, only: material_t
+  use model_sets, only: name_length
   use material_entry, only: vumat_entry, vusdfld_entry
   use material_kinematics, only: stretch_from_log_strain, defgrad_from_stretch
   implicit none
@@ -44,6 +45,14 @@ module material_door
 
   public :: vumat_work_init, call_material, packaging_modulus, checked_packaging_modulus
   public :: packaging_moduli, checked_packaging_moduli
+
+  !> The strain increment of the packaging call (direction 11).
+  real(dp), parameter :: packaging_strain = 1.0e-6_dp
+  !> elastic_moduli's answers, per material name and component count (found once).
+  integer :: known_count = 0
+  character(len=name_length), allocatable :: known_names(:)
+  integer, allocatable :: known_ncomp(:)
+  real(dp), allocatable :: known_moduli(:, :)
 
 contains
 
@@ -93,6 +102,7 @@ contains
     real(dp), allocatable, intent(inout) :: e_int(:), e_inel(:)
     type(vumat_work_t), intent(inout) :: w
     integer :: nstatev, nfieldv, nprops, ns, nf
+    real(dp) :: lambda, shear
     procedure(), pointer :: umat, usdfld
 
     if (mat%user_code) then
@@ -116,8 +126,10 @@ contains
     w%jblock(1:4) = [nb, 1, 1, 1]
     w%jblock(5:4 + nb) = elem_number
     if (mat%user_field) then
+       call elastic_moduli(mat, ncomp, nshr, lambda, shear)
        call host_set_block(nb, ncomp, stress, log_strain(1:nb, :))
        call host_set_block_extra(state(1:nb, 1:ns), w%temp(1:nb), peeq=state(1:nb, 1))
+       call host_set_block_moduli(lambda, shear)
        w%field_new(1:nb, 1:nfieldv) = field(1:nb, 1:nfieldv)
        call usdfld(nb, nstatev, nfieldv, nprops, 3, nshr, elem_number, 1, 1, 1, step_time, total_time, &
             dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), char_length, &
@@ -167,6 +179,7 @@ contains
     type(vumat_work_t), intent(inout) :: w
     procedure(), pointer :: umat, usdfld
     integer :: nstatev, nfieldv, nprops, ns, nf, i0, i1, n
+    real(dp) :: lambda, shear
 
     umat => vumat_entry(.true.)
     usdfld => vusdfld_entry(mat%user_field_code)
@@ -186,8 +199,10 @@ contains
        w%e_int_new(1:n) = e_int(i0:i1)
        w%e_inel_new(1:n) = e_inel(i0:i1)
        if (mat%user_field) then
+          call elastic_moduli(mat, ncomp, nshr, lambda, shear)
           call host_set_block(n, ncomp, stress(i0:i1, :), log_strain(i0:i1, :))
           call host_set_block_extra(state(i0:i1, 1:ns), w%temp(i0:i1))
+          call host_set_block_moduli(lambda, shear)
           call usdfld(n, nstatev, nfieldv, nprops, 3, nshr, elem_number(i0:i1), 1, 1, 1, step_time, &
                total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), w%direct(1:n, :, :), &
                char_length(i0:i1), mat%props, state(i0:i1, 1:ns), w%state_mid(1:n, 1:ns), &
@@ -390,7 +405,19 @@ contains
     type(material_t), intent(in) :: mat
     integer, intent(in) :: ncomp, nshr
     real(dp) :: modulus
-    real(dp), parameter :: probe = 1.0e-6_dp
+    real(dp) :: s11, s22
+
+    call packaging_probe(mat, ncomp, nshr, s11, s22)
+    modulus = s11 / packaging_strain
+  end function packaging_modulus
+
+  !> The packaging call itself: the stresses σ11 and σ22 answered to the strain increment
+  !> packaging_strain in direction 11 from a stress-free state at stepTime = totalTime = 0.
+  subroutine packaging_probe(mat, ncomp, nshr, s11, s22)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: ncomp, nshr
+    real(dp), intent(out) :: s11, s22
+    real(dp), parameter :: probe = packaging_strain
     real(dp) :: strain(1, ncomp), spin(1, nshr), stretch(1, ncomp), defgrad(1, ncomp + nshr)
     real(dp) :: stretch_new(1, ncomp), defgrad_new(1, ncomp + nshr)
     real(dp) :: stress_old(1, ncomp), stress_new(1, ncomp), state_old(1, max(1, mat%nstatev))
@@ -429,6 +456,38 @@ contains
          mat%vumat_name, coord, [1.0_dp], mat%props, density, strain, spin, scalar1, stretch, defgrad, &
          field, stress_old, state_old, e_old, e_old, scalar1, stretch_new, defgrad_new, field, stress_new, &
          state_new, e_new, ei_new)
-    modulus = stress_new(1, 1) / probe
-  end function packaging_modulus
+    s11 = stress_new(1, 1)
+    s22 = stress_new(1, 2)
+  end subroutine packaging_probe
+
+  !> The isotropic moduli λ = Δσ22/Δε11 and G = (Δσ11 − Δσ22)/(2 Δε11) of a material's packaging
+  !> call, found once per material and kept (vgetvrm('PE') for a VUSDFLD: PE = LE − C⁻¹:σ).
+  subroutine elastic_moduli(mat, ncomp, nshr, lambda, shear)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: ncomp, nshr
+    real(dp), intent(out) :: lambda, shear
+    real(dp) :: s11, s22
+    integer :: k
+
+    do k = 1, known_count
+       if (known_names(k) == mat%name .and. known_ncomp(k) == ncomp) then
+          lambda = known_moduli(1, k)
+          shear = known_moduli(2, k)
+          return
+       end if
+    end do
+    call packaging_probe(mat, ncomp, nshr, s11, s22)
+    lambda = s22 / packaging_strain
+    shear = (s11 - s22) / (2 * packaging_strain)
+    if (.not. allocated(known_names)) allocate(known_names(8), known_ncomp(8), known_moduli(2, 8))
+    if (known_count == size(known_names)) then
+       known_names = [known_names, known_names]
+       known_ncomp = [known_ncomp, known_ncomp]
+       known_moduli = reshape([known_moduli, known_moduli], [2, 2 * known_count])
+    end if
+    known_count = known_count + 1
+    known_names(known_count) = mat%name
+    known_ncomp(known_count) = ncomp
+    known_moduli(:, known_count) = [lambda, shear]
+  end subroutine elastic_moduli
 end module material_door

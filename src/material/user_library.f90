@@ -189,7 +189,7 @@ contains
     status = 0
   end subroutine user_library_prepare
 
-  !> dlopen `library` and take its vumat (required) and vusdfld (optional).
+  !> dlopen `library` and take its vumat and vusdfld (at least one of them).
   subroutine user_library_open(library, source, message, status)
     character(len=*), intent(in) :: library, source
     character(len=:), allocatable, intent(out) :: message
@@ -205,15 +205,18 @@ contains
             ' (a routine the file calls that neither it nor bulkflow defines?)'
        return
     end if
-    address = find_symbol(handle, 'vumat')
-    if (.not. c_associated(address)) then
-       message = 'user subroutine file ' // source // ' defines no subroutine VUMAT; expected ' // &
-            'SUBROUTINE VUMAT with the Abaqus/Explicit argument list'
-       return
-    end if
-    call c_f_procpointer(address, user_vumat)
+    ! A file with only a VUSDFLD serves *USER DEFINED FIELD of our built-in materials (as in
+    ! Abaqus, where user=FILE need not hold a VUMAT); it must hold at least one of the two.
     address = find_symbol(handle, 'vusdfld')
     if (c_associated(address)) call c_f_procpointer(address, user_vusdfld)
+    address = find_symbol(handle, 'vumat')
+    if (c_associated(address)) then
+       call c_f_procpointer(address, user_vumat)
+    else if (.not. associated(user_vusdfld)) then
+       message = 'user subroutine file ' // source // ' defines no subroutine VUMAT (nor VUSDFLD); ' // &
+            'expected SUBROUTINE VUMAT with the Abaqus/Explicit argument list'
+       return
+    end if
     loaded_name = source
     status = 0
   end subroutine user_library_open

@@ -27,10 +27,11 @@ module model
      real(dp) :: stress(6) = 0
   end type initial_stress_t
 
-  !> *INITIAL CONDITIONS, TYPE=FIELD (VARIABLE=n) or TYPE=TEMPERATURE (variable 0) on nodes;
-  !> element values are nodal means.
+  !> *INITIAL CONDITIONS, TYPE=FIELD (VARIABLE=n) or TYPE=TEMPERATURE (variable 0) on nodes
+  !> (element values are nodal means) or, in MPM scenes, on the particles of a material.
   type, public :: initial_field_t
      integer, allocatable :: nodes(:)
+     integer :: material = 0                  !< MPM scenes: the particles of this material
      integer :: variable = 1
      real(dp) :: value = 0
   end type initial_field_t

@@ -33,6 +33,17 @@ module model_steps
      character(len=256) :: source = ''        !< file:line of the *DLOAD data line
   end type gravity_t
 
+  !> *TEMPERATURE in a step (a predefined field): the temperature of nodes (MPM: of the particles
+  !> of a material) is `value` times the time variation's factor; nodes it does not name keep
+  !> their initial temperature. Several entries naming a node: the last one counts.
+  type, public :: temperature_t
+     integer, allocatable :: nodes(:)         !< internal node indices (empty in MPM scenes)
+     integer :: material = 0                  !< MPM: the particles of this material
+     real(dp) :: value = 0
+     type(time_variation_t) :: variation      !< amplitude, or held from an earlier step
+     character(len=256) :: source = ''
+  end type temperature_t
+
   !> *SURFACE INTERACTION + *FRICTION.
   type, public :: interaction_t
      character(len=name_length) :: name = ''
@@ -104,6 +115,7 @@ module model_steps
      real(dp) :: bulk_quadratic = 1.2_dp      !< *BULK VISCOSITY b2
      type(boundary_t), allocatable :: boundaries(:)
      type(gravity_t), allocatable :: gravity(:)
+     type(temperature_t), allocatable :: temperatures(:)
      type(contact_pair_t), allocatable :: contact_pairs(:)
      type(field_output_t), allocatable :: field_outputs(:)
      type(history_output_t), allocatable :: history_outputs(:)

@@ -44,6 +44,7 @@ module mpm_run
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, &
        mpm_restart_outputs
+  use driver_temperature, only: particle_temperature, particle_initial_field
   use material_door, only: vumat_work_t, vumat_work_init, call_material, checked_packaging_modulus
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
@@ -552,7 +553,7 @@ contains
     real(dp), intent(in) :: velocity(:)
     type(particle_block_t), allocatable :: grown(:)
     real(dp) :: dx, vol, half
-    integer :: n, done, ib, first, add, p, nd
+    integer :: n, done, ib, first, add, p, nd, k
 
     nd = st%nd
     n = size(pts, 2)
@@ -591,6 +592,13 @@ contains
          end do
          b%vol0(first:) = vol
          b%mass(first:) = m%materials(material)%density * vol
+         ! *INITIAL CONDITIONS, TYPE=FIELD of the material's particles (for a user's VUMAT or
+         ! VUSDFLD, as in elements; inflow particles start with them too)
+         if (m%materials(material)%user_code .or. m%materials(material)%user_field_code) then
+            do k = 1, size(b%field, 2)
+               b%field(first:, k) = particle_initial_field(m, material, k)
+            end do
+         end if
        end associate
        done = done + add
     end do
@@ -958,6 +966,10 @@ contains
        ! coordMp: the particle's position (the third column stays 0 in 2D)
        st%work(iw)%coord(1:nb, 1:nd) = b%x(1:nb, 1:nd)
     end if
+    ! tempOld, tempNew: the material's particle temperature at t_n and t_n+1 (driver_temperature)
+    st%work(iw)%temp(1:nb) = particle_temperature(m, st%step, b%material, st%step_time, st%total_time)
+    st%work(iw)%temp_new(1:nb) = particle_temperature(m, st%step, b%material, st%step_time + dt, &
+         st%total_time + dt)
     do p = 1, nb
        if (nd == 2) then
           density(p) = f_mid(p, 1, 1) * f_mid(p, 2, 2) - f_mid(p, 1, 2) * f_mid(p, 2, 1)

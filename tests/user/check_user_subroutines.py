@@ -7,16 +7,19 @@ the result against a closed form. Usage:
     check_user_subroutines.py CASE --bulkflow BIN --matpoint BIN --work DIR [--abaqus-file F]
 
 Cases
+  (the element and MPM probes with *TEMPERATURE, AMPLITUDE=: T = T0 + 400 t, tempOld and
+  tempNew checked at both ends of every increment)
   probe_cpe4r_rotation  one CPE4R element: stretch, then a rigid rotation of 50 degrees
   probe_c3d8r_rotation  one C3D8R element: stretch, then a rotation of 40 degrees about (1,2,3)
   probe_cpe4r_block     12 x 12 CPE4R (144 elements: one solver block, two VUMAT calls)
   probe_c3d8r_block     6 x 6 x 4 C3D8R (144 elements)
-  probe_mpm             an MPM column settling under gravity (400 particles)
+  probe_mpm             an MPM column settling under gravity (400 particles; temperature and
+                        two field variables from *INITIAL CONDITIONS on the material's particles)
   probe_matpoint        bulkflow-matpoint oedometer test
   single_file_elements  our single Abaqus file as --user == the built-in models, bit for bit
   single_file_mpm       the same for an MPM hopper
   bad_compile           a file that does not compile: compiler messages, exit status 2
-  bad_no_vumat          a file without VUMAT: exit status 2, says so
+  bad_no_vumat          a file with neither VUMAT nor VUSDFLD: exit status 2, says so
   bad_nan               a VUMAT returning NaN: exit 2 naming material, element/particle, time
 
 The probe VUMAT (probe_vumat.f) checks every argument itself and stops the run through
@@ -43,6 +46,8 @@ E, NU, RHO = 1.0e7, 0.3, 2000.0
 G = E / (2 * (1 + NU))
 LAM = E * NU / ((1 + NU) * (1 - 2 * NU))
 T0, F1, F2 = 293.0, 0.25, -1.5
+# dT/dt of the probe scenes' *TEMPERATURE, AMPLITUDE= (T = T0 + TRATE t, a linear amplitude)
+TRATE = 400.0
 
 
 class Failed(Exception):
@@ -74,14 +79,16 @@ def neo_hooke(f: np.ndarray) -> np.ndarray:
     return G / j * (f @ f.T - np.eye(3)) + LAM * math.log(j) / j * np.eye(3)
 
 
-def props_line(xc, check_coord: bool, nfieldv: int) -> str:
-    p = [float(v) for v in (E, NU, RHO, T0, F1, F2, *xc, 1.0 if check_coord else 0.0, nfieldv)]
+def props_line(xc, check_coord: bool, nfieldv: int, rate: float = 0.0) -> str:
+    p = [float(v) for v in (E, NU, RHO, T0, F1, F2, *xc, 1.0 if check_coord else 0.0, nfieldv, rate)]
     return ',\n'.join(', '.join(repr(v) for v in p[i:i + 8]) for i in range(0, len(p), 8))
 
 
-def element_scene(path: Path, ndim: int, n: tuple, stretch, axis, angle: float, total: float):
+def element_scene(path: Path, ndim: int, n: tuple, stretch, axis, angle: float, total: float,
+                  temp_rate: float = 0.0):
     """A homogeneous motion x = A(t) X of every node: stretch D over the first half, then the
-    rotation R over the second. Returns the final A and the reference centroids."""
+    rotation R over the second; with temp_rate, *TEMPERATURE, AMPLITUDE= makes the nodes'
+    temperature T0 + temp_rate t. Returns the final A and the reference centroids."""
     h = 0.1
     grids = [np.arange(k + 1) * h for k in n]
     coords = np.array(np.meshgrid(*grids, indexing='ij')).reshape(ndim, -1).T
@@ -123,8 +130,8 @@ def element_scene(path: Path, ndim: int, n: tuple, stretch, axis, angle: float, 
     if ndim == 2:
         lines.append('1.0')
     single = len(elems) == 1
-    lines += ['*MATERIAL, NAME=probe-neo', '*DENSITY', repr(RHO), '*USER MATERIAL, CONSTANTS=11',
-              props_line(centroids[0] if single else [0, 0, 0], single, 2), '*DEPVAR', '10',
+    lines += ['*MATERIAL, NAME=probe-neo', '*DENSITY', repr(RHO), '*USER MATERIAL, CONSTANTS=12',
+              props_line(centroids[0] if single else [0, 0, 0], single, 2, temp_rate), '*DEPVAR', '10',
               '*INITIAL CONDITIONS, TYPE=TEMPERATURE', f'NALL, {T0}',
               '*INITIAL CONDITIONS, TYPE=FIELD, VARIABLE=1', f'NALL, {F1}',
               '*INITIAL CONDITIONS, TYPE=FIELD, VARIABLE=2', f'NALL, {F2}']
@@ -138,6 +145,9 @@ def element_scene(path: Path, ndim: int, n: tuple, stretch, axis, angle: float, 
                 lines += [', '.join(pairs[m:m + 4]) for m in range(0, len(pairs), 4)]
     lines += ['*AMPLITUDE, NAME=LINEAR', f'0., 0., {total!r}, 1.',
               '*STEP, NAME=MOVE', '*DYNAMIC, EXPLICIT', f', {total!r}', '*BULK VISCOSITY', '0., 0.']
+    if temp_rate != 0:
+        lines[-5:-5] = ['*AMPLITUDE, NAME=TRAMP', f'0., {T0!r}, {total!r}, {T0 + temp_rate * total!r}']
+        lines += ['*TEMPERATURE, AMPLITUDE=TRAMP', 'NALL, 1.0']
     for k in range(coords.shape[0]):
         u = a_of(total) @ x3[k] - x3[k]
         for i in range(ndim):
@@ -181,7 +191,8 @@ def probe_elements(a, ndim: int, n: tuple, stretch, axis, angle: float):
     work = a.work
     work.mkdir(parents=True, exist_ok=True)
     scene = work / 'probe.inp'
-    f, centroids = element_scene(scene, ndim, n, stretch, axis, angle, 0.05)
+    total = 0.05
+    f, centroids = element_scene(scene, ndim, n, stretch, axis, angle, total, temp_rate=TRATE)
     run([a.bulkflow, str(scene), '--quiet', '--user', str(HERE / 'probe_vumat.f')], work)
     fr = last_frame(work / 'probe.h5', 'frames')
     s_want = neo_hooke(f)
@@ -192,7 +203,8 @@ def probe_elements(a, ndim: int, n: tuple, stretch, axis, angle: float):
     sdv = fr['SDV']
     check_close('SDV1 = J', sdv[:, 0], np.linalg.det(f), 1e-12)
     check_close('SDV2-4 = coordMp = F X_c', sdv[:, 1:4], centroids @ f.T, 1e-12)
-    check_close('SDV6 = temperature', sdv[:, 5], T0, 0)
+    check_close('SDV6 = tempNew = T0 + rate t (*TEMPERATURE, AMPLITUDE=) at the end', sdv[:, 5],
+                T0 + TRATE * total, 1e-9 * T0)
     check_close('SDV7, SDV8 = field 1, field 2', sdv[:, 6:8], [F1, F2], 0)
     sizes = sorted(set(sdv[:, 8].astype(int)))
     print(f'  nblock seen: {sizes}')
@@ -213,6 +225,7 @@ def probe_mpm(a):
     work = a.work
     work.mkdir(parents=True, exist_ok=True)
     scene = work / 'probe_mpm.inp'
+    total = 0.8
     height = 1.0
     g = 9.81
     scene.write_text(f"""*HEADING
@@ -224,10 +237,16 @@ probe VUMAT in MPM: a column settling under gravity on rollers
 *MATERIAL, NAME=Probe-MPM
 *DENSITY
 {RHO}
-*USER MATERIAL, CONSTANTS=11
-{props_line([0, 0, 0], False, 0)}
+*USER MATERIAL, CONSTANTS=12
+{props_line([0, 0, 0], False, 2, TRATE)}
 *DEPVAR
 10
+*INITIAL CONDITIONS, TYPE=TEMPERATURE
+PROBE-MPM, {T0!r}
+*INITIAL CONDITIONS, TYPE=FIELD, VARIABLE=1
+PROBE-MPM, {F1!r}
+*INITIAL CONDITIONS, TYPE=FIELD, VARIABLE=2
+PROBE-MPM, {F2!r}
 *PARTICLES, MATERIAL=PROBE-MPM, PPC=2
 0., 0.
 0.25, {height}
@@ -239,11 +258,15 @@ probe VUMAT in MPM: a column settling under gravity on rollers
 -0.2, 0., 0.4, 0.
 *AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP
 0., 0., 0.3, 1.
+*AMPLITUDE, NAME=TRAMP
+0., {T0!r}, {total!r}, {T0 + TRATE * total!r}
 *STEP, NAME=SETTLE
 *DYNAMIC, EXPLICIT
-, 0.8
+, {total!r}
 *DLOAD, AMPLITUDE=RAMP
 , GRAV, {g}, 0., -1.
+*TEMPERATURE, AMPLITUDE=TRAMP
+PROBE-MPM, 1.0
 *OUTPUT, FIELD, NUMBER INTERVAL=2
 *ELEMENT OUTPUT
 S, SDV
@@ -251,14 +274,14 @@ S, SDV
 *ENERGY OUTPUT
 *END STEP
 """.replace('T0_PLACEHOLDER', ''))
-    # MPM scenes have no temperature: the probe expects 0 (props(4)).
-    text = scene.read_text().replace(repr(T0), '0.0', 1)
-    scene.write_text(text)
     run([a.bulkflow, str(scene), '--quiet', '--user', str(HERE / 'probe_vumat.f')], work)
     fr = last_frame(work / 'probe_mpm.h5', 'particles')
     x = fr['coordinates']
     sdv = fr['SDV']
     check_close('SDV2-3 = coordMp = particle position', sdv[:, 1:3], x[:, 0:2], 1e-9)
+    check_close('SDV6 = tempNew = T0 + rate t (*TEMPERATURE on the particles) at the end', sdv[:, 5],
+                T0 + TRATE * total, 1e-9 * T0)
+    check_close('SDV7, SDV8 = field 1, field 2 (*INITIAL CONDITIONS on the particles)', sdv[:, 6:8], [F1, F2], 0)
     sizes = sorted(set(sdv[:, 8].astype(int)))
     print(f'  particles {len(x)}, nblock seen: {sizes}')
     if max(sizes) > 136:
@@ -283,7 +306,7 @@ probe VUMAT in the material-point driver: oedometer
 *MATERIAL, NAME=PROBE-POINT
 *DENSITY
 {RHO}
-*USER MATERIAL, CONSTANTS=11
+*USER MATERIAL, CONSTANTS=12
 {props_line([0, 0, 0], False, 0).replace(repr(T0), '0.0', 1)}
 *DEPVAR
 10
@@ -388,7 +411,7 @@ BROKEN = """      subroutine vumat(nblock, ndir)
       x = = 1
       end
 """
-NO_VUMAT = """      subroutine vusdfld(nblock)
+NO_VUMAT = """      subroutine vumat_helper(nblock)
       include 'vaba_param.inc'
       return
       end

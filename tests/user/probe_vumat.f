@@ -4,10 +4,10 @@ C     neo-Hookean solid whose stress comes from defgradNew, and on every call a 
 C     the arguments the host passes against what they must be (tests/user/README.md).
 C     Any failed check stops the run through xplb_abqerr(-3, ...).
 C
-C     props: 1 E, 2 nu, 3 rho0, 4 expected temperature, 5 field 1, 6 field 2,
+C     props: 1 E, 2 nu, 3 rho0, 4 expected temperature at t = 0, 5 field 1, 6 field 2,
 C            7-9 reference centroid X of the probed point (checked when props(10) = 1:
 C            coordMp = F X for a homogeneous motion that keeps the origin), 11 nfieldv
-C            expected.
+C            expected, 12 (optional) dT/dt of the scene's temperature (0: constant).
 C     SDVs:  1 J, 2-4 coordMp, 5 charLength, 6 tempNew, 7 field 1, 8 field 2, 9 nblock,
 C            10 number of increments seen.
       subroutine vumat(
@@ -96,11 +96,20 @@ C        The outputs hold the old values on entry.
      1      'enerInternNew does not hold enerInternOld on entry', k)
          if (enerInelasNew(k) .ne. enerInelasOld(k)) call fail(
      1      'enerInelasNew does not hold enerInelasOld on entry', k)
-C        Temperature and field variables of the scene.
-         if (abs(tempOld(k) - props(4)) .gt. tol * (1+abs(props(4))))
-     1      call fail('tempOld differs from the initial temperature', k)
-         if (tempNew(k) .ne. tempOld(k))
-     1      call fail('tempNew differs from tempOld', k)
+C        Temperature: props(4) + rate * t at the start (totalTime - dt)
+C        and the end (totalTime) of the increment, rate = props(12) when
+C        given (the scene's *TEMPERATURE amplitude), else constant.
+         rate = 0.d0
+         if (nprops .ge. 12) rate = props(12)
+         t0 = props(4) + rate * (totalTime - dt)
+         t1 = props(4) + rate * totalTime
+         if (abs(tempOld(k) - t0) .gt. tol * (1+abs(t0)))
+     1      call fail('tempOld is not the temperature at t_n', k)
+         if (abs(tempNew(k) - t1) .gt. tol * (1+abs(t1)))
+     1      call fail('tempNew is not the temperature at t_n+1', k)
+         if (abs(tempNew(k) - tempOld(k) - rate * dt) .gt.
+     1      tol * (1+abs(t1)))
+     2      call fail('tempNew - tempOld is not rate * dt', k)
          if (nfieldv .ge. 1) then
             if (abs(fieldNew(k,1) - props(5)) .gt. tol) call fail(
      1         'field 1 differs from the initial field 1', k)

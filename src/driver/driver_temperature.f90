@@ -1,0 +1,124 @@
+!> The predefined temperature in time at integration points and particles: *INITIAL CONDITIONS,
+!> TYPE=TEMPERATURE and the steps' *TEMPERATURE (model_steps' temperature_t: value × a(t), the
+!> last entry naming a node counts). A user's VUMAT receives it as tempOld (start of the
+!> increment) and tempNew (end), so the two differ within an increment when an amplitude varies.
+!>
+!> Elements: the integration point's temperature is the mean of its nodes' temperatures (the
+!> centroid value of the bilinear/trilinear interpolation), written as base + Σ_j coef_j a_j(t)
+!> with base the initial temperatures of the nodes no entry names; the coefficients are built
+!> once per step and block. Particles: all particles of a material share one temperature, the
+!> last entry naming the material, else its initial temperature.
+module driver_temperature
+  use material_kinds, only: dp
+  use model, only: model_t
+  use model_time_variation, only: variation_factor
+  use driver_solver, only: solver_t, element_block_t
+  implicit none
+  private
+
+  public :: element_temperatures, particle_temperature, particle_initial_field
+
+contains
+
+  !> temp(1:count) of block `blk` at the given step and total time of the current step.
+  subroutine element_temperatures(m, solver, blk, step_time, total_time, temp)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(in) :: solver
+    type(element_block_t), intent(inout) :: blk
+    real(dp), intent(in) :: step_time, total_time
+    real(dp), intent(out) :: temp(:)
+    integer :: j
+
+    if (blk%temp_step /= solver%step) call build_coefficients(m, solver, blk)
+    temp = blk%temp_base
+    do j = 1, size(blk%temp_coef, 2)
+       associate (t => m%steps(solver%step)%temperatures(j))
+         temp = temp + blk%temp_coef(:, j) * variation_factor(t%variation, m%amplitudes, step_time, total_time)
+       end associate
+    end do
+  end subroutine element_temperatures
+
+  !> base and coefficients of the block for the current step: node temperatures are the last
+  !> entry naming the node (coefficient value/nen), else the node's initial temperature.
+  subroutine build_coefficients(m, solver, blk)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(in) :: solver
+    type(element_block_t), intent(inout) :: blk
+    integer, allocatable :: entry_of(:)
+    real(dp), allocatable :: initial(:)
+    integer :: nent, j, i, e, a, g, node
+
+    nent = 0
+    if (allocated(m%steps(solver%step)%temperatures)) nent = size(m%steps(solver%step)%temperatures)
+    if (allocated(blk%temp_coef)) deallocate(blk%temp_coef)
+    allocate(blk%temp_coef(blk%count, nent))
+    blk%temp_coef = 0
+    blk%temp_base = blk%temp
+    blk%temp_step = solver%step
+    if (nent == 0) return
+    allocate(entry_of(m%mesh%n_nodes), initial(m%mesh%n_nodes))
+    entry_of = 0
+    initial = 0
+    do j = 1, nent
+       associate (t => m%steps(solver%step)%temperatures(j))
+         entry_of(t%nodes) = j
+       end associate
+    end do
+    if (allocated(m%initial_fields)) then
+       ! as driver_setup's element means: every initial entry naming a node adds its value
+       do j = 1, size(m%initial_fields)
+          if (m%initial_fields(j)%variable /= 0) cycle
+          do i = 1, size(m%initial_fields(j)%nodes)
+             node = m%initial_fields(j)%nodes(i)
+             initial(node) = initial(node) + m%initial_fields(j)%value
+          end do
+       end do
+    end if
+    do e = 1, blk%count
+       g = solver%part%elem_global(blk%first + e - 1)
+       do a = 1, m%mesh%nen
+          node = m%mesh%conn(a, g)
+          j = entry_of(node)
+          if (j == 0) cycle
+          blk%temp_base(e) = blk%temp_base(e) - initial(node) / m%mesh%nen
+          blk%temp_coef(e, j) = blk%temp_coef(e, j) + m%steps(solver%step)%temperatures(j)%value / m%mesh%nen
+       end do
+    end do
+  end subroutine build_coefficients
+
+  !> The temperature of the particles of `material` in step `step` at the given times.
+  real(dp) function particle_temperature(m, step, material, step_time, total_time) result(temp)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: step, material
+    real(dp), intent(in) :: step_time, total_time
+    integer :: j
+
+    if (allocated(m%steps(step)%temperatures)) then
+       do j = size(m%steps(step)%temperatures), 1, -1
+          associate (t => m%steps(step)%temperatures(j))
+            if (t%material /= material) cycle
+            temp = t%value * variation_factor(t%variation, m%amplitudes, step_time, total_time)
+            return
+          end associate
+       end do
+    end if
+    temp = particle_initial_field(m, material, 0)
+  end function particle_temperature
+
+  !> *INITIAL CONDITIONS of the particles of `material`: field `variable` (0: temperature); the
+  !> last entry naming the material counts, 0 without one.
+  real(dp) function particle_initial_field(m, material, variable) result(value)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: material, variable
+    integer :: j
+
+    value = 0
+    if (.not. allocated(m%initial_fields)) return
+    do j = size(m%initial_fields), 1, -1
+       if (m%initial_fields(j)%material == material .and. m%initial_fields(j)%variable == variable) then
+          value = m%initial_fields(j)%value
+          return
+       end if
+    end do
+  end function particle_initial_field
+end module driver_temperature
