@@ -8,7 +8,7 @@ module driver_run
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use model, only: model_t
-  use model_mesh, only: element_cpe4r
+  use model_mesh, only: element_cpe4r, element_cax4r
   use parallel_partition, only: partition_t, partition_model
   use parallel_assembly, only: global_min, global_sum
   use driver_solver, only: solver_t
@@ -26,6 +26,7 @@ module driver_run
   use driver_finite, only: energies_finite, stop_non_finite, non_finite_flag
   use driver_stop_condition, only: stop_step_start, check_stop_condition, report_stop_condition
   use fem_cpe4r, only: cpe4r_char_length
+  use fem_cax4r, only: cax4r_char_length
   use fem_c3d8r, only: c3d8r_char_length
   use fem_stable_dt, only: element_stable_dt
   use output_timer, only: timer_report
@@ -594,6 +595,8 @@ contains
          end do
          if (m%mesh%element_type == element_cpe4r) then
             call cpe4r_char_length(nb, xe, lc)
+         else if (m%mesh%element_type == element_cax4r) then
+            call cax4r_char_length(nb, xe, lc)
          else
             call c3d8r_char_length(nb, xe, blk%volume_ref, lc)
          end if

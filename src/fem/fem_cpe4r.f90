@@ -23,6 +23,8 @@ module fem_cpe4r
   public :: cpe4r_geometry, cpe4r_char_length, cpe4r_strain_increment
   public :: cpe4r_internal_force, cpe4r_hourglass_gamma, cpe4r_hourglass, cpe4r_hourglass_update
   public :: cpe4r_increment_kinematics, cpe4r_internal_force_bv
+  ! the per-element scalar kernels, shared with fem_cax4r
+  public :: quad_char_length, quad_displacement_gradient, add_mode_forces
 
   integer, parameter, public :: cpe4r_ndim = 2, cpe4r_nen = 4, cpe4r_ncomp = 4
   integer, parameter, public :: cpe4r_nshr = 1, cpe4r_nmode = 1

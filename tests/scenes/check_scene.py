@@ -213,6 +213,8 @@ def check_patch(p, run: Run) -> dict[str, float]:
     # (logarithmic) strain is log(F); sigma = lambda tr E I + 2 G E.
     f3 = np.eye(3)
     f3[:ndim, :ndim] += grad * t
+    if p.get('axisymmetric') == 'yes':
+        f3[2, 2] += grad[0, 0] * t              # hoop stretch r/R = 1 + a t of u_r = a r t
     w, q = np.linalg.eigh(f3)
     strain = q @ np.diag(np.log(w)) @ q.T
     sig = lam * np.trace(strain) * np.eye(3) + 2 * g * strain
@@ -310,7 +312,37 @@ def check_sections(p, run: Run) -> dict[str, float]:
     return {'returned': float(drop)}
 
 
-CHECKS = {'wave': check_wave, 'column': check_column, 'incline': check_incline, 'patch': check_patch,
+def check_lame(p, run: Run) -> dict[str, float]:
+    """Thick-walled cylinder, plane strain, bore displaced by u_a, outer surface free (Lame;
+    docs/theory/elements.md §5.6): u = A r + B/r, sigma_r = 2(lam+G)A - 2G B/r^2,
+    sigma_theta = 2(lam+G)A + 2G B/r^2, sigma_z = 2 lam A; sigma_r(b) = 0 and u(a) = u_a."""
+    lam, g, m, c = moduli(p)
+    a, b, u_a = float(p['inner']), float(p['outer']), float(p['u_inner'])
+    big_a = u_a / (a + (lam + g) * b ** 2 / (g * a))
+    big_b = (lam + g) * big_a * b ** 2 / g
+    pressure = -(2 * (lam + g) * big_a - 2 * g * big_b / a ** 2)
+    fields = read_fields(run.h5)
+    last = fields.frames[-1]
+    r = fields.centroids()[:, 0]
+    s = last.fields['S']
+    sr_exact = 2 * (lam + g) * big_a - 2 * g * big_b / r ** 2
+    st_exact = 2 * (lam + g) * big_a + 2 * g * big_b / r ** 2
+    rn = fields.x0[:, 0]
+    u_exact = big_a * rn + big_b / rn
+    figures = {'sigma_r': float(np.max(np.abs(s[:, 0] - sr_exact)) / pressure),
+               'sigma_theta': float(np.max(np.abs(s[:, 2] - st_exact)) / pressure),
+               'sigma_z': float(np.max(np.abs(s[:, 1] - 2 * lam * big_a)) / pressure),
+               'u_r': float(np.max(np.abs(last.fields['U'][:, 0] - u_exact)) / u_a)}
+    print(f'  {len(s)} elements, bore pressure p = {pressure:.5e} Pa, hoop stress at the bore '
+          f'{st_exact.max():.5e} Pa, t = {last.total_time:.4g} s')
+    report('radial stress error max |sigma_r - Lame| / p', 100 * figures['sigma_r'], 1.0, ' %')
+    report('hoop stress error max |sigma_theta - Lame| / p', 100 * figures['sigma_theta'], 1.0, ' %')
+    report('axial stress error max |sigma_z - 2 lam A| / p', 100 * figures['sigma_z'], 1.0, ' %')
+    report('radial displacement error max |u_r - (A r + B/r)| / u_a', 100 * figures['u_r'], 1.0, ' %')
+    return figures
+
+
+CHECKS = {'lame': check_lame, 'wave': check_wave, 'column': check_column, 'incline': check_incline, 'patch': check_patch,
           'dynamic': check_dynamic, 'sections': check_sections, 'rotation': check_rotation,
           'plastic_patch': check_plastic_patch}
 
