@@ -9,10 +9,11 @@
 !> polynomials of the bilinear map), with S = ∫ r dA:
 !>   B_rI = (1/S) ∫ r ∂N_I/∂r dA,  B_zI = (1/S) ∫ r ∂N_I/∂z dA,  B_θI = (1/S) ∫ N_I dA.
 !> Σ_I B_rI r_I = Σ_I B_zI z_I = 1, Σ_I B_rI z_I = Σ_I B_zI r_I = 0, Σ_I B_θI r_I = 1: the field
-!> u_r = a r, u_z = c z (+ a z translation) gives exactly Δε = (a, c, a, 0). On a parallelogram
-!> aligned with the axes these rows are the plane mean gradient and N_I(0)/r̄ (the hoop row at
-!> the centroid radius). f = V B̄ᵀσ = ∂(σ-weighted V)/∂x, so uniform stress with σ_rr = σ_θθ
-!> leaves every interior node balanced, whatever the distortion.
+!> u_r = a r, u_z = c z (+ a z translation) gives exactly Δε = (a, c, a, 0). On a rectangle
+!> aligned with the axes the r row is the plane mean gradient and the hoop row is N_I(0)/r̄ (the
+!> hoop row at the centroid radius r̄); the z row weights the nodes by their radius. With
+!> S = ∫ r dA: S B_zI = ∂S/∂z_I and S (B_rI + B_θI) = ∂S/∂r_I, so uniform stress with
+!> σ_rr = σ_θθ leaves every interior node balanced, whatever the distortion.
 !> Nodal masses: m_I = ρ 2π ∫ N_I r dA (share_I = ∫ N_I r dA / S), the row sum of the
 !> consistent ring mass; gravity loads m_I g are then the consistent ones.
 !> Stable increment: L_e = 1/√(1/L_p² + 3 Σ_I B_θI²), L_p = A / longest edge (CPE4R's);
