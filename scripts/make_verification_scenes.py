@@ -695,7 +695,7 @@ def mpi_column_3d() -> Scene:
 
 
 # ---------------------------------------------------------------------------------------------
-# 10. CAX4R axisymmetric elements (x = r, y = z; docs/theory/elements.md §5)
+# 10. CAX4R axisymmetric elements (x = r, y = z; docs/theory/elements.md §3.10)
 
 def lame_cax4r(nr=24, inner=0.1, outer=0.2, ramp_periods=20.0, hold_periods=4.0) -> Scene:
     # Thick-walled cylinder in plane strain (top and bottom on rollers, u_z = 0), driven at the

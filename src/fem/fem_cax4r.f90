@@ -3,7 +3,7 @@
 !>
 !> The element is the full 360° ring: volume V = 2π ∫ r dA, so masses, internal forces and
 !> energies are those of the whole ring (Abaqus's convention for concentrated loads and
-!> reaction forces on axisymmetric models; docs/theory/elements.md §5).
+!> reaction forces on axisymmetric models; docs/theory/elements.md §3.10).
 !>
 !> Uniform strain: B̄ = (1/V) ∫_V B dV, every integral exact (2×2 Gauss is exact for these
 !> polynomials of the bilinear map), with S = ∫ r dA:
@@ -18,7 +18,7 @@
 !> consistent ring mass; gravity loads m_I g are then the consistent ones.
 !> Stable increment: L_e = 1/√(1/L_p² + 3 Σ_I B_θI²), L_p = A / longest edge (CPE4R's);
 !> the hoop term keeps ω_max L_e at most that of the plane-strain element of the same shape
-!> (docs/theory/elements.md §5.4).
+!> (docs/theory/elements.md §3.10).
 !> Components (nb, 4): 11 = rr, 22 = zz, 33 = θθ, 12 = rz (tensor shear), as Abaqus passes them.
 module fem_cax4r
   use material_kinds, only: dp
@@ -39,7 +39,7 @@ module fem_cax4r
   real(dp), parameter :: xi_node(4) = [-1.0_dp, 1.0_dp, 1.0_dp, -1.0_dp]
   real(dp), parameter :: eta_node(4) = [-1.0_dp, -1.0_dp, 1.0_dp, 1.0_dp]
   real(dp), parameter :: hg_base(4) = [1.0_dp, -1.0_dp, 1.0_dp, -1.0_dp]
-  !> weight of Σ B_θ² in L_e (chosen with the element eigenvalues, docs/theory/elements.md §5.4)
+  !> weight of Σ B_θ² in L_e (chosen with the element eigenvalues, docs/theory/elements.md §3.10)
   real(dp), parameter :: hoop_dt_weight = 3.0_dp
 
 contains

@@ -314,7 +314,7 @@ def check_sections(p, run: Run) -> dict[str, float]:
 
 def check_lame(p, run: Run) -> dict[str, float]:
     """Thick-walled cylinder, plane strain, bore displaced by u_a, outer surface free (Lame;
-    docs/theory/elements.md §5.6): u = A r + B/r, sigma_r = 2(lam+G)A - 2G B/r^2,
+    docs/theory/elements.md §3.10): u = A r + B/r, sigma_r = 2(lam+G)A - 2G B/r^2,
     sigma_theta = 2(lam+G)A + 2G B/r^2, sigma_z = 2 lam A; sigma_r(b) = 0 and u(a) = u_a."""
     lam, g, m, c = moduli(p)
     a, b, u_a = float(p['inner']), float(p['outer']), float(p['u_inner'])
