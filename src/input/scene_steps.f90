@@ -23,13 +23,14 @@ module scene_steps
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_syntax
   use model, only: model_t
   use model_sets, only: find_set, name_length
-  use model_steps, only: step_t, gravity_t, contact_pair_t, mass_scaling_t, mass_scaling_below_min, &
+  use model_steps, only: step_t, gravity_t, pressure_t, contact_pair_t, mass_scaling_t, mass_scaling_below_min, &
        mass_scaling_uniform
   use scene_layout, only: scene_layout_t
   use scene_amplitudes, only: amplitude_param
   use scene_boundaries, only: bc_state_t, bc_init, bc_clear, read_boundary, bc_resolve, boundary_op, &
        bc_carry
   use scene_step_continuity, only: warn_gravity_jumps
+  use scene_pressure, only: read_dsload
   use model_time_variation, only: time_variation_t, carry_into_step
   use scene_outputs, only: output_state_t, outputs_step_start, read_output, read_output_option, time_marks
   use scene_surfaces, only: find_element_surface, find_rigid_surface
@@ -46,6 +47,8 @@ module scene_steps
      type(bc_state_t) :: bcs
      integer :: n_gravity = 0
      type(gravity_t), allocatable :: gravity(:)
+     integer :: n_pressures = 0
+     type(pressure_t), allocatable :: pressures(:)
      integer :: n_pairs = 0
      type(contact_pair_t), allocatable :: pairs(:)
      type(output_state_t) :: outputs
@@ -69,7 +72,7 @@ contains
     real(dp) :: step_end
 
     call bc_init(c%bcs, model%mesh%n_nodes)
-    allocate (c%gravity(0), c%pairs(0), c%mass_scaling(0))
+    allocate (c%gravity(0), c%pressures(0), c%pairs(0), c%mass_scaling(0))
     do i = 1, deck%n_blocks
        if (layout%step_of(i) /= 0) cycle
        select case (deck%blocks(i)%name)
@@ -98,6 +101,10 @@ contains
              call carry_into_step(c%gravity(k)%variation, model%amplitudes, model%steps(s - 1)%period, &
                   step_end)
           end do
+          do k = 1, c%n_pressures
+             call carry_into_step(c%pressures(k)%variation, model%amplitudes, model%steps(s - 1)%period, &
+                  step_end)
+          end do
        end if
        call read_step(deck, layout, s, model, c, model%steps(s), err)
        if (err%raised) return
@@ -116,7 +123,7 @@ contains
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: name
     integer :: i, i0, i1, j, n_options, dynamic_block, stop_block
-    logical :: bc_new, dload_new
+    logical :: bc_new, dload_new, dsload_new
 
     i0 = layout%step_block(s)
     i1 = layout%end_block(s)
@@ -138,7 +145,9 @@ contains
 
     call op_new_rule(deck, i0, i1, 'BOUNDARY', bc_new, err)
     if (.not. err%raised) call op_new_rule(deck, i0, i1, 'DLOAD', dload_new, err)
+    if (.not. err%raised) call op_new_rule(deck, i0, i1, 'DSLOAD', dsload_new, err)
     if (err%raised) return
+    if (dsload_new) c%n_pressures = 0
     if (bc_new) call bc_clear(c%bcs)
     if (dload_new) c%n_gravity = 0
     call outputs_step_start(c%outputs)
@@ -161,6 +170,8 @@ contains
             call read_boundary(blk, model, .true., c%bcs, err)
          case ('DLOAD')
             call read_dload(blk, model, c, err)
+         case ('DSLOAD')
+            call read_dsload(blk, model, c%pressures, c%n_pressures, err)
          case ('CONTACT PAIR')
             call read_contact_pair(blk, model, .true., c, err)
          case ('BULK VISCOSITY')
@@ -213,6 +224,7 @@ contains
     call bc_resolve(c%bcs, step%boundaries)
     step%mass_scaling = c%mass_scaling(1:c%n_mass_scaling)
     step%gravity = c%gravity(1:c%n_gravity)
+    step%pressures = c%pressures(1:c%n_pressures)
     step%contact_pairs = c%pairs(1:c%n_pairs)
     step%field_outputs = c%outputs%field(1:c%outputs%n_field)
     step%history_outputs = c%outputs%history(1:c%outputs%n_history)

@@ -15,7 +15,8 @@ module scene_surfaces
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_text
   use model, only: model_t
   use model_sets, only: find_set, name_length
-  use model_surfaces, only: element_surface_t, rigid_surface_t, segment_t, segment_line, segment_arc
+  use model_surfaces, only: element_surface_t, rigid_surface_t, segment_t, segment_line, segment_arc, &
+       cpe4r_faces, c3d8r_faces
   use scene_layout, only: scene_layout_t
   use scene_sets, only: elem_targets
   use scene_util, only: itoa, rtoa, get_real, field_name, expect_fields, expect_lines, &
@@ -25,10 +26,6 @@ module scene_surfaces
 
   public :: build_surfaces, build_rigid_bodies, find_element_surface, find_rigid_surface
 
-  !> Abaqus face numbering: local nodes of face S1..S4 of CPE4R and S1..S6 of C3D8R.
-  integer, parameter :: cpe4r_faces(2, 4) = reshape([1, 2, 2, 3, 3, 4, 4, 1], [2, 4])
-  integer, parameter :: c3d8r_faces(4, 6) = reshape([1, 2, 3, 4, 5, 8, 7, 6, 1, 5, 6, 2, &
-       2, 6, 7, 3, 3, 7, 8, 4, 4, 8, 5, 1], [4, 6])
 
   !> Relative tolerance on the two radii of a CIRCL segment (coordinates typed with a
   !> few digits, e.g. 0.7071 for sqrt(1/2), must pass).

@@ -48,7 +48,7 @@ def expected_effects(scene: Path) -> tuple[list[str], list[str]]:
                 and not line.startswith('**')}
     present = ['elements', 'material', 'hourglass', 'assembly', 'output']
     absent = []
-    for effect, keyword in (('rigid walls', '*CONTACT PAIR'), ('user field', '*USER DEFINED FIELD'),
+    for effect, keyword in (('pressure', '*DSLOAD'), ('rigid walls', '*CONTACT PAIR'), ('user field', '*USER DEFINED FIELD'),
                             ('gravity', '*DLOAD'), ('checkpoint', '*RESTART'), ('boundary', '*BOUNDARY')):
         (present if keyword in keywords else absent).append(effect)
     return present, absent
@@ -313,14 +313,15 @@ def check_sections(p, run: Run) -> dict[str, float]:
 
 
 def check_lame(p, run: Run) -> dict[str, float]:
-    """Thick-walled cylinder, plane strain, bore displaced by u_a, outer surface free (Lame;
+    """Thick-walled cylinder, plane strain, internal pressure p, outer surface free (Lame;
     docs/theory/elements.md §3.10): u = A r + B/r, sigma_r = 2(lam+G)A - 2G B/r^2,
-    sigma_theta = 2(lam+G)A + 2G B/r^2, sigma_z = 2 lam A; sigma_r(b) = 0 and u(a) = u_a."""
+    sigma_theta = 2(lam+G)A + 2G B/r^2, sigma_z = 2 lam A; sigma_r(a) = -p, sigma_r(b) = 0:
+    A = p a^2 / (2 (lam+G)(b^2 - a^2)), B = p a^2 b^2 / (2 G (b^2 - a^2))."""
     lam, g, m, c = moduli(p)
-    a, b, u_a = float(p['inner']), float(p['outer']), float(p['u_inner'])
-    big_a = u_a / (a + (lam + g) * b ** 2 / (g * a))
-    big_b = (lam + g) * big_a * b ** 2 / g
-    pressure = -(2 * (lam + g) * big_a - 2 * g * big_b / a ** 2)
+    a, b, pressure = float(p['inner']), float(p['outer']), float(p['pressure'])
+    big_a = pressure * a ** 2 / (2 * (lam + g) * (b ** 2 - a ** 2))
+    big_b = pressure * a ** 2 * b ** 2 / (2 * g * (b ** 2 - a ** 2))
+    u_a = big_a * a + big_b / a
     fields = read_fields(run.h5)
     last = fields.frames[-1]
     r = fields.centroids()[:, 0]
