@@ -42,13 +42,16 @@ contains
     if (err%raised) return
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
-         call expect_fields(blk, dl, 3, 3, 'element surface, P, magnitude', err)
+         ! the load type first: a traction (TRSHR, TRVEC: more fields) is named as such
+         call expect_fields(blk, dl, 2, huge(1), 'element surface, P, magnitude', err)
          if (err%raised) return
          if (field_name(dl, 2) /= 'P') then
             call raise_error(dl%file, dl%line, 'load type "' // dl%field(2) // '" is not supported; ' // &
                  'expected P (uniform pressure)', err)
             return
          end if
+         call expect_fields(blk, dl, 3, 3, 'element surface, P, magnitude', err)
+         if (err%raised) return
          name = field_name(dl, 1)
          p = pressure_t()
          p%surface = find_element_surface(model, name)
