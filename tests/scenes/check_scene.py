@@ -344,7 +344,22 @@ def check_lame(p, run: Run) -> dict[str, float]:
     return figures
 
 
-CHECKS = {'lame': check_lame, 'wave': check_wave, 'column': check_column, 'incline': check_incline, 'patch': check_patch,
+def check_floor(p, run: Run) -> dict[str, float]:
+    """A body at rest on a rigid floor after the gravity ramp: the floor carries its weight m g
+    (the second half of the history rows after the ramp)."""
+    mass, grav, ramp = float(p['mass']), float(p['g']), float(p['ramp'])
+    h = read_history(run.history_csv)
+    wall = [k for k in h if k.startswith('WALLF2_')][0]
+    t = h['time']
+    settled = t > ramp + 0.5 * (t[-1] - ramp)
+    force = h[wall][settled]
+    figures = {'weight': float(np.max(np.abs(force / (-mass * grav) - 1)))}
+    print(f'  {wall}: mean {force.mean():.6e} N over {settled.sum()} rows; weight m g = {mass * grav:.6e} N')
+    report('floor force vs the weight of the full ring, worst row', 100 * figures['weight'], 1.0, ' %')
+    return figures
+
+
+CHECKS = {'floor': check_floor, 'lame': check_lame, 'wave': check_wave, 'column': check_column, 'incline': check_incline, 'patch': check_patch,
           'dynamic': check_dynamic, 'sections': check_sections, 'rotation': check_rotation,
           'plastic_patch': check_plastic_patch}
 
