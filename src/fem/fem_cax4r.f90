@@ -23,10 +23,10 @@
 module fem_cax4r
   use material_kinds, only: dp
   use fem_hourglass, only: hourglass_viscous, hourglass_stiffness
-  use fem_plane_frame, only: plane_defgrad, plane_rotation, plane_similarity, plane_relative_spin
+  use fem_plane_frame, only: plane_corotational_step
   use fem_inversion, only: inversion_none, inversion_centre, inversion_corner, inversion_collapse, &
        inversion_axis
-  use fem_cpe4r, only: quad_char_length, quad_displacement_gradient, add_mode_forces
+  use fem_cpe4r, only: quad_char_length, quad_displacement_gradient, add_mode_forces, stiffness_mode_force
   implicit none
   private
 
@@ -161,8 +161,7 @@ contains
     real(dp), intent(out) :: r_mid(nb, 2, 2), r_new(nb, 2, 2), r_plane(nb, 2, 1), f_new(nb, 2, 2)
     real(dp), intent(out) :: strain_inc_corot(nb, 4), rel_spin(nb, 1)
     real(dp) :: mr(4), mz(4), nr(4), nz(4), br(4), bz(4), bt(4), sh(4), area, vol, hx, hy, jmin
-    real(dp) :: l11, l12, l21, l22, hoop, spin, f11, f21, f12, f22, q11, q21, q12, q22
-    real(dp) :: n11, n21, n12, n22
+    real(dp) :: l11, l12, l21, l22, hoop, spin
     integer :: e, k
 
     do e = 1, nb
@@ -215,34 +214,18 @@ contains
        if (minval(nr) < 0.0_dp) k = inversion_axis
        reason(e) = k
 
-       ! Green–Naghdi R in the r–z plane, F_{n+½}, F_{n+1} from the reference B̄
-       call plane_defgrad(mr(2) - mr(1), mr(3) - mr(1), mr(4) - mr(1), mz(2) - mz(1), mz(3) - mz(1), &
-            mz(4) - mz(1), bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
-            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
-       call plane_rotation(f11, f21, f12, f22, q11, q21, q12, q22)
-       r_mid(e, 1, 1) = q11
-       r_mid(e, 2, 1) = q21
-       r_mid(e, 1, 2) = q12
-       r_mid(e, 2, 2) = q22
-       call plane_defgrad(nr(2) - nr(1), nr(3) - nr(1), nr(4) - nr(1), nz(2) - nz(1), nz(3) - nz(1), &
-            nz(4) - nz(1), bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), bmat_ref(e, 2, 2), &
-            bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), f11, f21, f12, f22)
-       f_new(e, 1, 1) = f11
-       f_new(e, 2, 1) = f21
-       f_new(e, 1, 2) = f12
-       f_new(e, 2, 2) = f22
-       call plane_rotation(f11, f21, f12, f22, n11, n21, n12, n22)
-       r_new(e, 1, 1) = n11
-       r_new(e, 2, 1) = n21
-       r_new(e, 1, 2) = n12
-       r_new(e, 2, 2) = n22
-       r_plane(e, 1, 1) = n11
-       r_plane(e, 2, 1) = n21
-       call plane_similarity(q11, q21, q12, q22, l11, l22, 0.5_dp * (l12 + l21), &
-            strain_inc_corot(e, 1), strain_inc_corot(e, 2), strain_inc_corot(e, 4))
+       ! Green–Naghdi R in the r–z plane from the reference B̄ (fem_plane_frame); θθ is not rotated
+       call plane_corotational_step(mr(2) - mr(1), mr(3) - mr(1), mr(4) - mr(1), mz(2) - mz(1), &
+            mz(3) - mz(1), mz(4) - mz(1), nr(2) - nr(1), nr(3) - nr(1), nr(4) - nr(1), nz(2) - nz(1), &
+            nz(3) - nz(1), nz(4) - nz(1), bmat_ref(e, 1, 2), bmat_ref(e, 1, 3), bmat_ref(e, 1, 4), &
+            bmat_ref(e, 2, 2), bmat_ref(e, 2, 3), bmat_ref(e, 2, 4), l11, l22, 0.5_dp * (l12 + l21), spin, &
+            r_old(e, 1, 1), r_old(e, 2, 1), r_mid(e, 1, 1), r_mid(e, 2, 1), r_mid(e, 1, 2), r_mid(e, 2, 2), &
+            f_new(e, 1, 1), f_new(e, 2, 1), f_new(e, 1, 2), f_new(e, 2, 2), &
+            r_new(e, 1, 1), r_new(e, 2, 1), r_new(e, 1, 2), r_new(e, 2, 2), &
+            strain_inc_corot(e, 1), strain_inc_corot(e, 2), strain_inc_corot(e, 4), rel_spin(e, 1))
        strain_inc_corot(e, 3) = hoop
-       rel_spin(e, 1) = plane_relative_spin(spin, n11, n21, n12, n22, r_old(e, 1, 1), r_old(e, 2, 1), &
-            -r_old(e, 2, 1), r_old(e, 1, 1))
+       r_plane(e, 1, 1) = r_new(e, 1, 1)
+       r_plane(e, 2, 1) = r_new(e, 2, 1)
     end do
   end subroutine cax4r_increment_kinematics
 
@@ -280,7 +263,7 @@ contains
     real(dp), intent(in) :: coefficient, rot_mid(nb, 2, 2), rot_new(nb, 2, 2)
     real(dp), intent(inout) :: hg_state(nb, 2, 1), fe(nb, 2, 4), force_hg(nb, 2, 1)
     real(dp), intent(out) :: energy_inc(nb), work(nb)
-    real(dp) :: g1, g2, g3, g4, q1, q2, qc1, qc2, h1, h2, qg1, qg2, c, dtm, area
+    real(dp) :: g1, g2, g3, g4, q1, q2, qg1, qg2, c, dtm, area
     integer :: e
 
     dtm = max(dt, tiny(1.0_dp))
@@ -300,17 +283,9 @@ contains
           energy_inc(e) = (0.0_dp + qg1 * q1) + qg2 * q2
        else if (kind == hourglass_stiffness) then
           c = coefficient * 0.25_dp * modulus(e) * volume_mid(e) * bsq(e)
-          qc1 = (0.0_dp + rot_mid(e, 1, 1) * q1) + rot_mid(e, 2, 1) * q2
-          qc2 = (0.0_dp + rot_mid(e, 1, 2) * q1) + rot_mid(e, 2, 2) * q2
-          h1 = hg_state(e, 1, 1)
-          h2 = hg_state(e, 2, 1)
-          energy_inc(e) = (0.0_dp + (h1 + 0.5_dp * c * qc1) * qc1) + (h2 + 0.5_dp * c * qc2) * qc2
-          h1 = h1 + c * qc1
-          h2 = h2 + c * qc2
-          hg_state(e, 1, 1) = h1
-          hg_state(e, 2, 1) = h2
-          qg1 = (0.0_dp + rot_new(e, 1, 1) * h1) + rot_new(e, 1, 2) * h2
-          qg2 = (0.0_dp + rot_new(e, 2, 1) * h1) + rot_new(e, 2, 2) * h2
+          call stiffness_mode_force(c, q1, q2, rot_mid(e, 1, 1), rot_mid(e, 2, 1), rot_mid(e, 1, 2), &
+               rot_mid(e, 2, 2), rot_new(e, 1, 1), rot_new(e, 2, 1), rot_new(e, 1, 2), rot_new(e, 2, 2), &
+               hg_state(e, 1, 1), hg_state(e, 2, 1), qg1, qg2, energy_inc(e))
        else
           qg1 = 0.0_dp
           qg2 = 0.0_dp
