@@ -263,17 +263,18 @@ contains
     real(dp), intent(in) :: coefficient, rot_mid(nb, 2, 2), rot_new(nb, 2, 2)
     real(dp), intent(inout) :: hg_state(nb, 2, 1), fe(nb, 2, 4), force_hg(nb, 2, 1)
     real(dp), intent(out) :: energy_inc(nb), work(nb)
-    real(dp) :: g1, g2, g3, g4, q1, q2, qg1, qg2, c, dtm, area
+    real(dp) :: q1, q2, qg1, qg2, c, dtm, area
     integer :: e
 
     dtm = max(dt, tiny(1.0_dp))
     do e = 1, nb
-       g1 = gamma(e, 1)
-       g2 = gamma(e, 2)
-       g3 = gamma(e, 3)
-       g4 = gamma(e, 4)
-       q1 = (((0.0_dp + g1 * du(e, 1, 1)) + g2 * du(e, 1, 2)) + g3 * du(e, 1, 3)) + g4 * du(e, 1, 4)
-       q2 = (((0.0_dp + g1 * du(e, 2, 1)) + g2 * du(e, 2, 2)) + g3 * du(e, 2, 3)) + g4 * du(e, 2, 4)
+       ! the mode's amplitudes q_i = Σ_I γ_I du_iI
+       q1 = sum(gamma(e, :) * du(e, 1, :))
+       q2 = sum(gamma(e, :) * du(e, 2, :))
+       ! no hourglass control (kind none): no force, no energy
+       qg1 = 0.0_dp
+       qg2 = 0.0_dp
+       energy_inc(e) = 0.0_dp
        if (kind == hourglass_viscous) then
           area = max(area_mid(e), tiny(1.0_dp))
           c = coefficient * 0.25_dp * sqrt(density(e) * modulus(e)) * (abs(volume_mid(e)) / area) &
@@ -286,12 +287,8 @@ contains
           call stiffness_mode_force(c, q1, q2, rot_mid(e, 1, 1), rot_mid(e, 2, 1), rot_mid(e, 1, 2), &
                rot_mid(e, 2, 2), rot_new(e, 1, 1), rot_new(e, 2, 1), rot_new(e, 1, 2), rot_new(e, 2, 2), &
                hg_state(e, 1, 1), hg_state(e, 2, 1), qg1, qg2, energy_inc(e))
-       else
-          qg1 = 0.0_dp
-          qg2 = 0.0_dp
-          energy_inc(e) = 0.0_dp
        end if
-       call add_mode_forces(g1, g2, g3, g4, q1, q2, qg1, qg2, fe(e, 1, 1), fe(e, 2, 1), fe(e, 1, 2), &
+       call add_mode_forces(gamma(e, 1), gamma(e, 2), gamma(e, 3), gamma(e, 4), q1, q2, qg1, qg2, fe(e, 1, 1), fe(e, 2, 1), fe(e, 1, 2), &
             fe(e, 2, 2), fe(e, 1, 3), fe(e, 2, 3), fe(e, 1, 4), fe(e, 2, 4), force_hg(e, 1, 1), &
             force_hg(e, 2, 1), work(e))
     end do

@@ -12,7 +12,7 @@ module scene_pressure
   use model_time_variation, only: time_variation_t
   use scene_amplitudes, only: amplitude_param
   use scene_boundaries, only: boundary_op
-  use scene_surfaces, only: find_element_surface, find_rigid_surface
+  use scene_surfaces, only: require_element_surface
   use scene_util, only: get_real, field_name, expect_fields, expect_lines, where_text
   implicit none
   private
@@ -29,7 +29,6 @@ contains
     integer, intent(inout) :: n
     type(error_t), intent(inout) :: err
     type(pressure_t) :: p
-    type(pressure_t), allocatable :: tmp(:)
     character(len=:), allocatable :: op, name
     integer :: il, amp, j, k
 
@@ -54,17 +53,9 @@ contains
          if (err%raised) return
          name = field_name(dl, 1)
          p = pressure_t()
-         p%surface = find_element_surface(model, name)
-         if (p%surface == 0) then
-            if (find_rigid_surface(model, name) > 0) then
-               call raise_error(dl%file, dl%line, 'surface ' // name // ' is an analytic rigid surface; ' // &
-                    'expected a *SURFACE, TYPE=ELEMENT of the mesh', err)
-            else
-               call raise_error(dl%file, dl%line, 'surface ' // name // ' is not defined; expected the ' // &
-                    'name of a *SURFACE, TYPE=ELEMENT', err)
-            end if
-            return
-         end if
+         call require_element_surface(model, dl, name, 'an analytic rigid surface; expected a ' // &
+              '*SURFACE, TYPE=ELEMENT of the mesh', p%surface, err)
+         if (err%raised) return
          call get_real(dl, 3, p%magnitude, err)
          if (err%raised) return
          p%variation = time_variation_t(amplitude=amp)
@@ -73,17 +64,14 @@ contains
          do k = 1, n
             if (list(k)%surface == p%surface) j = k
          end do
-         if (j == 0) then
+         if (j > 0) then
+            list(j) = p
+         else
+            ! a new surface: lists are short (one entry per loaded surface)
             if (.not. allocated(list)) allocate (list(0))
-            if (n >= size(list)) then
-               allocate (tmp(2 * n + 2))
-               tmp(1:n) = list(1:n)
-               call move_alloc(tmp, list)
-            end if
+            list = [list(1:n), p]
             n = n + 1
-            j = n
          end if
-         list(j) = p
        end associate
     end do
   end subroutine read_dsload

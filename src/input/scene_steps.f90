@@ -33,7 +33,7 @@ module scene_steps
   use scene_pressure, only: read_dsload
   use model_time_variation, only: time_variation_t, carry_into_step
   use scene_outputs, only: output_state_t, outputs_step_start, read_output, read_output_option, time_marks
-  use scene_surfaces, only: find_element_surface, find_rigid_surface
+  use scene_surfaces, only: find_rigid_surface, require_element_surface
   use scene_interactions, only: find_interaction
   use scene_util, only: itoa, rtoa, get_real, get_real_param, field_name, field_blank, &
        expect_fields, expect_lines, where_text, check_name
@@ -459,18 +459,10 @@ contains
          if (err%raised) return
          slave = field_name(dl, 1)
          master = field_name(dl, 2)
-         ks = find_element_surface(model, slave)
+         call require_element_surface(model, dl, slave, 'a rigid surface; expected the element ' // &
+              'surface first and the rigid surface second', ks, err)
+         if (err%raised) return
          km = find_rigid_surface(model, master)
-         if (ks == 0) then
-            if (find_rigid_surface(model, slave) /= 0) then
-               call raise_error(dl%file, dl%line, 'surface ' // slave // ' is a rigid surface; expected ' // &
-                    'the element surface first and the rigid surface second', err)
-            else
-               call raise_error(dl%file, dl%line, 'surface ' // slave // ' is not defined; expected the ' // &
-                    'name of a *SURFACE, TYPE=ELEMENT', err)
-            end if
-            return
-         end if
          if (km == 0) then
             call raise_error(dl%file, dl%line, 'surface ' // master // ' is not a rigid surface; ' // &
                  'expected the name of a *SURFACE, TYPE=SEGMENTS or TYPE=PLANE', err)

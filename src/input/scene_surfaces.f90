@@ -24,7 +24,7 @@ module scene_surfaces
   implicit none
   private
 
-  public :: build_surfaces, build_rigid_bodies, find_element_surface, find_rigid_surface
+  public :: build_surfaces, build_rigid_bodies, find_element_surface, find_rigid_surface, require_element_surface
 
 
   !> Relative tolerance on the two radii of a CIRCL segment (coordinates typed with a
@@ -376,4 +376,23 @@ contains
        end associate
     end do
   end subroutine build_rigid_bodies
+
+  !> k = the element surface `name` of data line dl, or an error at dl: "is a rigid surface"
+  !> followed by `rigid_expected` when it names a rigid surface, else "is not defined".
+  subroutine require_element_surface(model, dl, name, rigid_expected, k, err)
+    type(model_t), intent(in) :: model
+    type(data_line_t), intent(in) :: dl
+    character(len=*), intent(in) :: name, rigid_expected
+    integer, intent(out) :: k
+    type(error_t), intent(inout) :: err
+
+    k = find_element_surface(model, name)
+    if (k > 0) return
+    if (find_rigid_surface(model, name) /= 0) then
+       call raise_error(dl%file, dl%line, 'surface ' // name // ' is ' // rigid_expected, err)
+    else
+       call raise_error(dl%file, dl%line, 'surface ' // name // ' is not defined; expected the ' // &
+            'name of a *SURFACE, TYPE=ELEMENT', err)
+    end if
+  end subroutine require_element_surface
 end module scene_surfaces
