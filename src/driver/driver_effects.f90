@@ -19,11 +19,12 @@ module driver_effects
   integer, parameter, public :: effect_assembly = 9        !< force assembly incl. MPI exchange
   integer, parameter, public :: effect_output = 10         !< field, history, progress
   integer, parameter, public :: effect_checkpoint = 11
-  integer, parameter, public :: n_effects = 11
+  integer, parameter, public :: effect_pressure = 12       !< *DSLOAD follower pressure
+  integer, parameter, public :: n_effects = 12
 
   character(len=16), parameter, public :: effect_names(n_effects) = [character(len=16) :: &
        'elements', 'material', 'user field', 'hourglass', 'bulk viscosity', 'gravity', &
-       'rigid walls', 'boundary', 'assembly', 'output', 'checkpoint']
+       'rigid walls', 'boundary', 'assembly', 'output', 'checkpoint', 'pressure']
 
   type, public :: effects_t
      logical :: active(n_effects) = .false.
@@ -58,6 +59,9 @@ contains
        associate (s => m%steps(i))
          if (allocated(s%gravity)) then
             if (size(s%gravity) > 0) this%active(effect_gravity) = .true.
+         end if
+         if (allocated(s%pressures)) then
+            if (size(s%pressures) > 0) this%active(effect_pressure) = .true.
          end if
          if (s%bulk_linear > 0 .or. s%bulk_quadratic > 0) this%active(effect_bulk_viscosity) = .true.
          if (allocated(s%contact_pairs)) then

@@ -9,7 +9,7 @@ module driver_elements
   use material_kinds, only: dp
   use error_report, only: raise_error
   use model, only: model_t
-  use model_mesh, only: element_cpe4r
+  use model_mesh, only: element_cpe4r, element_cax4r
   use driver_solver, only: solver_t, element_block_t
   use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
        effect_bulk_viscosity, effect_user_field, effect_assembly
@@ -18,6 +18,8 @@ module driver_elements
   use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_internal_force_bv, &
        cpe4r_hourglass_update
   use fem_c3d8r, only: c3d8r_kinematics, c3d8r_internal_force, c3d8r_hourglass
+  use fem_cax4r, only: cax4r_increment_kinematics, cax4r_internal_force, cax4r_hourglass_update, &
+       cax4r_hoop_stretch
   use fem_corotation, only: corotational_increment, deformation_gradient, to_global, rotation_matrix, &
        vumat_defgrad, vumat_stretch
   use fem_bulk_viscosity, only: bulk_viscosity
@@ -40,6 +42,8 @@ module driver_elements
      real(dp), allocatable :: volume_mid(:), volume_new(:), char_length(:), density(:), modulus(:)
      real(dp), allocatable :: volume_abs(:)           !< |volume_mid| (no temporary per call)
      real(dp), allocatable :: gamma(:, :), bsq(:)     !< CPE4R: hourglass γ, Σ B² of B_{n+½}
+     real(dp), allocatable :: bhoop_new(:, :), area_mid(:)  !< CAX4R: hoop row of B̄_{n+1}, |A| of x_{n+½}
+     real(dp), allocatable :: hoop_stretch(:)         !< CAX4R: F33 = U33 for the VUMAT
      real(dp), allocatable :: e_hg_kernel(:)          !< the hourglass kernel's own ΔE (not booked)
      real(dp), allocatable :: wave_speed(:), sigma_bv(:), xi(:), e_bv(:), e_hg(:), dt_el(:)
      real(dp), allocatable :: strain_inc(:, :), spin_inc(:, :), strain_corot(:, :), rel_spin(:, :)
@@ -81,6 +85,7 @@ contains
     allocate(w%modulus(nmax), w%wave_speed(nmax), w%sigma_bv(nmax), w%xi(nmax), w%e_bv(nmax))
     allocate(w%e_hg(nmax), w%dt_el(nmax), w%reason(nmax), w%volume_abs(nmax), w%e_hg_kernel(nmax))
     allocate(w%gamma(nmax, nen), w%bsq(nmax))
+    allocate(w%bhoop_new(nmax, nen), w%area_mid(nmax), w%hoop_stretch(nmax))
     allocate(w%strain_inc(nmax, ncomp), w%spin_inc(nmax, nshr), w%strain_corot(nmax, ncomp))
     allocate(w%rel_spin(nmax, nshr), w%stress_force(nmax, ncomp), w%stress_global(nmax, ncomp))
     allocate(w%r_mid(nmax, ndim, ndim), w%r_new(nmax, ndim, ndim), w%f_old(nmax, ndim, ndim))
@@ -307,12 +312,20 @@ contains
     integer :: e, nc, ns, a, i, hourglass_kind
     real(dp) :: hourglass_coefficient
     character(len=64) :: text
-    logical :: plane, bulk
+    logical :: plane, bulk, axisym
 
     nc = solver%ncomp
     ns = solver%nshr
-    plane = m%mesh%element_type == element_cpe4r
-    if (plane) then
+    ! plane: the 2D paths (plane rotation, fused kernels); axisym: CAX4R's own kernels among them
+    axisym = m%mesh%element_type == element_cax4r
+    plane = m%mesh%element_type == element_cpe4r .or. axisym
+    if (axisym) then
+       call cax4r_increment_kinematics(nb, w%xe_old, w%du, blk%bmat_ref, blk%volume_ref, &
+            default_min_volume_ratio, m%materials(blk%material)%density, blk%rotation, w%volume_mid, &
+            w%volume_abs, w%area_mid, w%density, w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, &
+            w%bhoop_new, w%char_length, w%reason, w%r_mid, w%r_new, w%r_plane, w%f_new, w%strain_corot, &
+            w%rel_spin)
+    else if (plane) then
        ! Kinematics, inversion check, corotational step and density in one pass.
        ! The section's thickness and the material's density, from which the set-up formed V0 and
        ! blk%mass = ρ0 V0 (kinematics forms ρ0 V0 again: the same bits).
@@ -362,6 +375,16 @@ contains
           call vumat_stretch(nb, nd, blk%rotation, w%f_old(1:nb, :, :), w%stretch_old(1:nb, :))
        end if
        call vumat_stretch(nb, nd, w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%stretch_new(1:nb, :))
+       if (axisym) then
+          ! the hoop stretch r̄/R̄ is F33 = U33 (θ is a principal direction)
+          call cax4r_hoop_stretch(nb, w%xe_ref, w%xe_old, w%hoop_stretch)
+          w%defgrad_old(1:nb, 3) = w%hoop_stretch
+          w%stretch_old(1:nb, 3) = w%hoop_stretch
+          w%xe_new(1:nb, :, :) = w%xe_old(1:nb, :, :) + w%du(1:nb, :, :)
+          call cax4r_hoop_stretch(nb, w%xe_ref, w%xe_new, w%hoop_stretch)
+          w%defgrad_new(1:nb, 3) = w%hoop_stretch
+          w%stretch_new(1:nb, 3) = w%hoop_stretch
+       end if
        call centroids(nb, nd, ne, w%xe_old, w%du, w%vumat%coord)
        ! *INITIAL CONDITIONS, TYPE=TEMPERATURE and the step's *TEMPERATURE at t_n and t_n+1
        call element_temperatures(m, solver, blk, solver%step_time, solver%total_time, w%vumat%temp(1:nb))
@@ -439,7 +462,11 @@ contains
        call effects%stop(effect_bulk_viscosity)
        call effects%start(effect_elements)
     end if
-    if (plane .and. bulk) then
+    if (axisym) then
+       ! w%xi is zero without bulk viscosity: no σ_bv then
+       call cax4r_internal_force(nb, w%volume_new, w%bmat_new, w%bhoop_new, w%stress_global, &
+            merge(blk%sigma_bv, w%xi, bulk), w%fe)
+    else if (plane .and. bulk) then
        call cpe4r_internal_force_bv(nb, w%volume_new, w%bmat_new, w%stress_global, blk%sigma_bv, w%fe)
     else if (plane) then
        call cpe4r_internal_force(nb, w%volume_new, w%bmat_new, w%stress_global, w%fe)
@@ -465,7 +492,11 @@ contains
        ! the two agree up to the rotation of the increment. blk%force_hg keeps f_{n+1} for the
        ! next increment: C3D8R the change of fe the hourglass forces make, CPE4R its generalised
        ! force (cpe4r_hourglass_update).
-       if (plane) then
+       if (axisym) then
+          call cax4r_hourglass_update(nb, w%gamma, w%bsq, w%volume_mid, w%area_mid, w%du, dt, w%density, &
+               w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, blk%hourglass, w%fe, &
+               blk%force_hg, w%e_hg_kernel, w%e_hg)
+       else if (plane) then
           ! One fused kernel: forces, force change and work in one pass over the block.
           call cpe4r_hourglass_update(nb, m%sections(blk%section)%thickness, w%gamma, w%bsq, w%volume_mid, &
                w%du, dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, &

@@ -115,6 +115,8 @@ contains
                     end if
                     do a = 1, solver%nen
                        fe(le, 1, a) = blk%mass(e) / solver%nen
+                       ! CAX4R: the ring's nodal shares (the nodal masses' own, fem_cax4r)
+                       if (allocated(blk%mass_share)) fe(le, 1, a) = blk%mass(e) * blk%mass_share(e, a)
                     end do
                  end do
                end associate

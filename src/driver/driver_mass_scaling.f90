@@ -22,11 +22,13 @@ module driver_mass_scaling
   use, intrinsic :: iso_fortran_env, only: output_unit
   use material_kinds, only: dp
   use model, only: model_t
-  use model_mesh, only: element_cpe4r
+  use model_mesh, only: element_cpe4r, element_cax4r
   use model_steps, only: mass_scaling_uniform
   use parallel_assembly, only: assemble_element_vectors, global_min, global_max
   use driver_solver, only: solver_t
   use fem_cpe4r, only: cpe4r_geometry, cpe4r_char_length
+  use fem_cax4r, only: cax4r_geometry, cax4r_char_length
+  use driver_setup, only: shared_node_mass
   use fem_c3d8r, only: c3d8r_geometry, c3d8r_char_length
   use fem_stable_dt, only: element_stable_dt
   use fem_mass, only: lumped_mass
@@ -105,6 +107,8 @@ contains
            blk%mass_scaled = maxval(abs(blk%mass_scale - 1)) > 0
            allocate(mass_b(nb, solver%nen))
            call lumped_mass(nb, solver%nen, blk%mass * blk%mass_scale / blk%volume_ref, blk%volume_ref, mass_b)
+           if (allocated(blk%mass_share)) call shared_node_mass(nb, solver%nen, blk%mass * blk%mass_scale, &
+                blk%mass_share, mass_b)
            mass_e(blk%first:blk%first + nb - 1, 1, :) = mass_b
            deallocate(mass_b)
            fmin = min(fmin, minval(blk%mass_scale))
@@ -142,6 +146,7 @@ contains
     real(dp), intent(in) :: b1
     real(dp), intent(out) :: dt_el(:)
     real(dp), allocatable :: xe(:, :, :), lc(:), c(:), xi(:), dte(:), vol(:), bmat(:, :, :)
+    real(dp), allocatable :: hoop(:, :), share(:, :)
     integer :: ib, nb, e, a, i, node
 
     do ib = 1, solver%n_blocks
@@ -160,6 +165,11 @@ contains
          if (m%mesh%element_type == element_cpe4r) then
             call cpe4r_geometry(nb, xe, m%sections(blk%section)%thickness, vol, bmat)
             call cpe4r_char_length(nb, xe, lc)
+         else if (m%mesh%element_type == element_cax4r) then
+            allocate(hoop(nb, 4), share(nb, 4))
+            call cax4r_geometry(nb, xe, vol, bmat, hoop, share)
+            call cax4r_char_length(nb, xe, lc)
+            deallocate(hoop, share)
          else
             call c3d8r_geometry(nb, xe, vol, bmat)
             call c3d8r_char_length(nb, xe, vol, lc)

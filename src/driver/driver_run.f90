@@ -8,11 +8,11 @@ module driver_run
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use model, only: model_t
-  use model_mesh, only: element_cpe4r
+  use model_mesh, only: element_cpe4r, element_cax4r
   use parallel_partition, only: partition_t, partition_model
   use parallel_assembly, only: global_min, global_sum
   use driver_solver, only: solver_t
-  use driver_effects, only: effects_t, effect_gravity, effect_rigid_walls, effect_boundary, &
+  use driver_effects, only: effects_t, effect_gravity, effect_pressure, effect_rigid_walls, effect_boundary, &
        effect_assembly, effect_output, effect_checkpoint, effect_user_field
   use driver_setup, only: setup_solver, initial_internal_forces
   use driver_elements, only: element_workspace_t, element_workspace_init, element_phase
@@ -23,9 +23,11 @@ module driver_run
        history_interval, output_frequency, sum_over_ranks
   use driver_checkpoint, only: save_checkpoint, load_checkpoint
   use driver_mass_scaling, only: apply_step_mass_scaling
+  use driver_pressure, only: step_pressures_t, prepare_pressures, add_pressure_forces
   use driver_finite, only: energies_finite, stop_non_finite, non_finite_flag
   use driver_stop_condition, only: stop_step_start, check_stop_condition, report_stop_condition
   use fem_cpe4r, only: cpe4r_char_length
+  use fem_cax4r, only: cax4r_char_length
   use fem_c3d8r, only: c3d8r_char_length
   use fem_stable_dt, only: element_stable_dt
   use output_timer, only: timer_report
@@ -67,6 +69,7 @@ contains
     type(effects_t) :: effects
     type(element_workspace_t) :: ew
     type(step_loads_t) :: loads
+    type(step_pressures_t) :: pressures
     type(run_output_t) :: out
     integer :: istep, first_step, max_state, max_field, i, frames, rows
     real(dp) :: dt_min, energies(6)
@@ -107,6 +110,7 @@ contains
     condition_met = .false.
     do istep = first_step, m%n_steps
        call prepare_step(m, istep, solver, loads)
+       call prepare_pressures(m, istep, solver, pressures)
        period = m%steps(istep)%period
        if (.not. resumed) then
           solver%step = istep
@@ -119,6 +123,8 @@ contains
           if (istep == 1) then
              call initial_internal_forces(m, solver)
              call gravity_forces(m, loads, solver, 0.0_dp, solver%f_ext)
+             if (effects%active(effect_pressure)) &
+                  call add_pressure_forces(m, pressures, solver, 0.0_dp, 0.0_dp, solver%f_ext)
              call update_accelerations(solver)
              solver%dt_stable = initial_stable_dt(m, solver, m%steps(1)%bulk_linear)
              call energy_values(solver, energies)
@@ -128,6 +134,10 @@ contains
              ! 0 of this step, and accelerations/reactions with this step's prescribed dofs (a dof
              ! released now must accelerate in the first increment, not keep a = 0).
              if (effects%active(effect_gravity)) call gravity_forces(m, loads, solver, 0.0_dp, solver%f_ext)
+             if (effects%active(effect_pressure)) then
+                if (.not. effects%active(effect_gravity)) solver%f_ext = 0
+                call add_pressure_forces(m, pressures, solver, 0.0_dp, 0.0_dp, solver%f_ext)
+             end if
              call update_accelerations(solver)
           end if
           call write_outputs(m, solver, out, effects, istep)
@@ -135,7 +145,7 @@ contains
        resumed = .false.
 
        do while (solver%step_time < period * (1 - 1.0e-12_dp))
-          call one_increment(m, solver, effects, ew, loads, istep, dt_min)
+          call one_increment(m, solver, effects, ew, loads, pressures, istep, dt_min)
           call write_outputs(m, solver, out, effects, istep)
           call progress_line(m, solver, out, istep, .false.)
           if (effects%active(effect_checkpoint)) then
@@ -182,12 +192,13 @@ contains
   end subroutine run_scene
 
   !> One central-difference increment, t_n → t_{n+1}.
-  subroutine one_increment(m, solver, effects, ew, loads, istep, dt_min)
+  subroutine one_increment(m, solver, effects, ew, loads, pressures, istep, dt_min)
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
     type(effects_t), intent(inout) :: effects
     type(element_workspace_t), intent(inout) :: ew
     type(step_loads_t), intent(in) :: loads
+    type(step_pressures_t), intent(in) :: pressures
     integer, intent(in) :: istep
     real(dp), intent(out) :: dt_min
     real(dp) :: dt, dt_avg, t_mid, t_new, work, free_sum
@@ -250,6 +261,19 @@ contains
          call effects%start(effect_gravity)
          call gravity_forces(m, loads, solver, t_new, solver%f_ext)
          call effects%stop(effect_gravity)
+         if (effects%active(effect_pressure)) then
+            call effects%start(effect_pressure)
+            call add_pressure_forces(m, pressures, solver, t_new, dt, solver%f_ext)
+            call effects%stop(effect_pressure)
+         end if
+         call finish_nodes(solver, solver%f_ext_old)
+      else if (effects%active(effect_pressure)) then
+         ! follower pressure on the geometry of t_{n+1} (+ gravity, constant here)
+         solver%f_ext_old = solver%f_ext
+         call effects%start(effect_pressure)
+         call gravity_forces(m, loads, solver, t_new, solver%f_ext)
+         call add_pressure_forces(m, pressures, solver, t_new, dt, solver%f_ext)
+         call effects%stop(effect_pressure)
          call finish_nodes(solver, solver%f_ext_old)
       else
          call finish_nodes(solver, solver%f_ext)
@@ -594,6 +618,8 @@ contains
          end do
          if (m%mesh%element_type == element_cpe4r) then
             call cpe4r_char_length(nb, xe, lc)
+         else if (m%mesh%element_type == element_cax4r) then
+            call cax4r_char_length(nb, xe, lc)
          else
             call c3d8r_char_length(nb, xe, blk%volume_ref, lc)
          end if

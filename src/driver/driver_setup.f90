@@ -4,13 +4,14 @@
 module driver_setup
   use material_kinds, only: dp
   use model, only: model_t
-  use model_mesh, only: element_cpe4r
+  use model_mesh, only: element_cpe4r, element_cax4r
   use parallel_partition, only: partition_t, local_node_index, local_elem_index
   use parallel_assembly, only: assemble_element_vectors, block_assembly_t, block_assembly_init, &
        assembly_start, assembly_add_block, assembly_finish
   use driver_solver, only: solver_t, element_block_t, build_blocks
   use material_door, only: checked_packaging_modulus
   use fem_cpe4r, only: cpe4r_geometry, cpe4r_internal_force
+  use fem_cax4r, only: cax4r_geometry, cax4r_internal_force
   use fem_c3d8r, only: c3d8r_geometry, c3d8r_internal_force
   use fem_corotation, only: identity_rotation, stored_to_global
   use fem_mass, only: lumped_mass
@@ -18,7 +19,7 @@ module driver_setup
   implicit none
   private
 
-  public :: setup_solver, initial_internal_forces
+  public :: setup_solver, initial_internal_forces, shared_node_mass
 
 contains
 
@@ -75,6 +76,7 @@ contains
          ! Through a block-sized array: a section of mass_e would be copied in and out.
          allocate(mass_b(nb, solver%nen))
          call lumped_mass(nb, solver%nen, blk%mass / blk%volume_ref, blk%volume_ref, mass_b)
+         if (allocated(blk%mass_share)) call shared_node_mass(nb, solver%nen, blk%mass, blk%mass_share, mass_b)
          mass_e(blk%first:blk%first + nb - 1, 1, :) = mass_b
          deallocate(mass_b)
        end associate
@@ -151,7 +153,7 @@ contains
       blk%nfieldv = max(1, mat%nfieldv)
       allocate(blk%elem_number(nb), blk%volume_ref(nb), blk%bmat_ref(nb, nd, ne))
       allocate(blk%mass(nb), blk%hourglass(nb, nd, solver%nmode))
-      if (m%mesh%element_type == element_cpe4r) then
+      if (m%mesh%element_type == element_cpe4r .or. m%mesh%element_type == element_cax4r) then
          allocate(blk%rotation(nb, 2, 1))
       else
          allocate(blk%rotation(nb, nd, nd))
@@ -162,7 +164,7 @@ contains
       blk%temp = 0
       ! Hourglass forces of t_n for the ALLAE work: CPE4R keeps the generalised force Q (nb, 2, 1)
       ! of its one mode (cpe4r_hourglass_update), C3D8R the nodal forces (nb, 3, 8).
-      if (m%mesh%element_type == element_cpe4r) then
+      if (m%mesh%element_type == element_cpe4r .or. m%mesh%element_type == element_cax4r) then
          allocate(blk%sigma_bv(nb), blk%force_hg(nb, nd, 1))
       else
          allocate(blk%sigma_bv(nb), blk%force_hg(nb, nd, ne))
@@ -197,6 +199,10 @@ contains
       end do
       if (m%mesh%element_type == element_cpe4r) then
          call cpe4r_geometry(nb, xe, m%sections(blk%section)%thickness, blk%volume_ref, blk%bmat_ref)
+      else if (m%mesh%element_type == element_cax4r) then
+         ! the full ring: the section thickness does not apply (Abaqus ignores it too)
+         allocate(blk%mass_share(nb, 4), blk%bhoop_ref(nb, 4))
+         call cax4r_geometry(nb, xe, blk%volume_ref, blk%bmat_ref, blk%bhoop_ref, blk%mass_share)
       else
          call c3d8r_geometry(nb, xe, blk%volume_ref, blk%bmat_ref)
       end if
@@ -213,12 +219,25 @@ contains
     end associate
   end subroutine setup_block
 
+  !> CAX4R nodal masses: element mass × its nodal share (fem_cax4r: ∫ N_I r dA / ∫ r dA), in
+  !> place of lumped_mass's equal quarters.
+  pure subroutine shared_node_mass(nb, nen, element_mass, share, mass_b)
+    integer, intent(in) :: nb, nen
+    real(dp), intent(in) :: element_mass(nb), share(nb, nen)
+    real(dp), intent(out) :: mass_b(nb, nen)
+    integer :: a
+
+    do a = 1, nen
+       mass_b(:, a) = element_mass * share(:, a)
+    end do
+  end subroutine shared_node_mass
+
   !> Internal forces of the current global stresses on the reference configuration: the
   !> forces at t = 0 (initial stresses), before any increment.
   subroutine initial_internal_forces(m, solver)
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
-    integer :: ib, nb
+    integer :: ib, nb, e
     real(dp), allocatable :: fe(:, :, :), stress_global(:, :)
     type(block_assembly_t) :: ba
 
@@ -232,6 +251,9 @@ contains
               stress_global)
          if (m%mesh%element_type == element_cpe4r) then
             call cpe4r_internal_force(nb, blk%volume_ref, blk%bmat_ref, stress_global, fe)
+         else if (m%mesh%element_type == element_cax4r) then
+            call cax4r_internal_force(nb, blk%volume_ref, blk%bmat_ref, blk%bhoop_ref, stress_global, &
+                 [(0.0_dp, e = 1, nb)], fe)
          else
             call c3d8r_internal_force(nb, blk%volume_ref, blk%bmat_ref, stress_global, fe)
          end if

@@ -9,7 +9,7 @@
 module driver_solver
   use material_kinds, only: dp
   use model, only: model_t
-  use model_mesh, only: element_cpe4r
+  use model_mesh, only: element_c3d8r
   use parallel_partition, only: partition_t
   implicit none
   private
@@ -24,6 +24,10 @@ module driver_solver
      real(dp), allocatable :: volume_ref(:)
      real(dp), allocatable :: bmat_ref(:, :, :)       !< (count, ndim, nen) reference mean gradient
      real(dp), allocatable :: mass(:)                 !< element mass ρ0 V0
+     !> CAX4R: (count, 4) share of the element mass at each node (∫ N_I r dA / ∫ r dA);
+     !> unallocated for CPE4R and C3D8R (mass/nen at each node)
+     real(dp), allocatable :: mass_share(:, :)
+     real(dp), allocatable :: bhoop_ref(:, :)         !< CAX4R: (count, 4) hoop row of B̄ on X
      !> R at t_n: C3D8R (count, 3, 3); CPE4R (count, 2, 1), the plane form (cos θ, sin θ) of
      !> R = [c −s; s c] (fem_corotation's rotation_matrix): half the bytes read and written per
      !> element and increment.
@@ -146,7 +150,7 @@ contains
     end do
     solver%ndim = m%mesh%ndim
     solver%nen = m%mesh%nen
-    if (m%mesh%element_type == element_cpe4r) then
+    if (m%mesh%element_type /= element_c3d8r) then   ! CPE4R, CAX4R
        solver%ncomp = 4; solver%nshr = 1; solver%nmode = 1
     else
        solver%ncomp = 6; solver%nshr = 3; solver%nmode = 4

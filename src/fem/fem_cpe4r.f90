@@ -15,7 +15,7 @@
 module fem_cpe4r
   use material_kinds, only: dp
   use fem_hourglass, only: hourglass_viscous, hourglass_stiffness
-  use fem_plane_frame, only: plane_defgrad, plane_rotation, plane_similarity, plane_relative_spin
+  use fem_plane_frame, only: plane_corotational_step
   use fem_inversion, only: inversion_none, inversion_centre, inversion_corner, inversion_collapse
   implicit none
   private
@@ -23,6 +23,8 @@ module fem_cpe4r
   public :: cpe4r_geometry, cpe4r_char_length, cpe4r_strain_increment
   public :: cpe4r_internal_force, cpe4r_hourglass_gamma, cpe4r_hourglass, cpe4r_hourglass_update
   public :: cpe4r_increment_kinematics, cpe4r_internal_force_bv
+  ! the per-element scalar kernels, shared with fem_cax4r
+  public :: quad_char_length, quad_displacement_gradient, add_mode_forces, stiffness_mode_force
 
   integer, parameter, public :: cpe4r_ndim = 2, cpe4r_nen = 4, cpe4r_ncomp = 4
   integer, parameter, public :: cpe4r_nshr = 1, cpe4r_nmode = 1
@@ -140,7 +142,6 @@ contains
     real(dp) :: mx1, mx2, mx3, mx4, my1, my2, my3, my4, nx1, nx2, nx3, nx4, ny1, ny2, ny3, ny4
     real(dp) :: area, vol, jmin, hx, hy
     real(dp) :: b11, b12, b13, b14, b21, b22, b23, b24, l11, l12, l21, l22, spin
-    real(dp) :: f11, f21, f12, f22, q11, q12, q21, q22, n11, n12, n21, n22
     real(dp) :: r11, r12, r13, r14, r21, r22, r23, r24, vol_ref
     integer :: e, r
 
@@ -219,34 +220,18 @@ contains
        if (vol <= 0.0_dp) r = inversion_centre
        reason(e) = r
 
-       ! corotational_increment_2d: F_{n+½} and R_{n+½}, F_{n+1} and R_{n+1}
-       call plane_defgrad(mx2 - mx1, mx3 - mx1, mx4 - mx1, my2 - my1, my3 - my1, my4 - my1, &
-            r12, r13, r14, r22, r23, r24, f11, f21, f12, f22)
-       call plane_rotation(f11, f21, f12, f22, q11, q21, q12, q22)
-       r_mid(e, 1, 1) = q11
-       r_mid(e, 2, 1) = q21
-       r_mid(e, 1, 2) = q12
-       r_mid(e, 2, 2) = q22
-       call plane_defgrad(nx2 - nx1, nx3 - nx1, nx4 - nx1, ny2 - ny1, ny3 - ny1, ny4 - ny1, &
-            r12, r13, r14, r22, r23, r24, f11, f21, f12, f22)
-       f_new(e, 1, 1) = f11
-       f_new(e, 2, 1) = f21
-       f_new(e, 1, 2) = f12
-       f_new(e, 2, 2) = f22
-       call plane_rotation(f11, f21, f12, f22, n11, n21, n12, n22)
-       r_new(e, 1, 1) = n11
-       r_new(e, 2, 1) = n21
-       r_new(e, 1, 2) = n12
-       r_new(e, 2, 2) = n22
-       r_plane(e, 1, 1) = n11
-       r_plane(e, 2, 1) = n21
-       ! strainInc = R_{n+½}ᵀ Δε R_{n+½} (q a qᵀ with q = R_{n+½}ᵀ)
-       call plane_similarity(q11, q21, q12, q22, l11, l22, 0.5_dp * (l12 + l21), &
-            strain_inc_corot(e, 1), strain_inc_corot(e, 2), strain_inc_corot(e, 4))
+       ! corotational_increment_2d: F_{n+½} and R_{n+½}, F_{n+1} and R_{n+1}, strainInc =
+       ! R_{n+½}ᵀ Δε R_{n+½}, relSpinInc with ΔR = R_{n+1} R_nᵀ, R_n = [c −s; s c] (plane form)
+       call plane_corotational_step(mx2 - mx1, mx3 - mx1, mx4 - mx1, my2 - my1, my3 - my1, my4 - my1, &
+            nx2 - nx1, nx3 - nx1, nx4 - nx1, ny2 - ny1, ny3 - ny1, ny4 - ny1, r12, r13, r14, r22, r23, r24, &
+            l11, l22, 0.5_dp * (l12 + l21), spin, r_old(e, 1, 1), r_old(e, 2, 1), &
+            r_mid(e, 1, 1), r_mid(e, 2, 1), r_mid(e, 1, 2), r_mid(e, 2, 2), &
+            f_new(e, 1, 1), f_new(e, 2, 1), f_new(e, 1, 2), f_new(e, 2, 2), &
+            r_new(e, 1, 1), r_new(e, 2, 1), r_new(e, 1, 2), r_new(e, 2, 2), &
+            strain_inc_corot(e, 1), strain_inc_corot(e, 2), strain_inc_corot(e, 4), rel_spin(e, 1))
        strain_inc_corot(e, 3) = 0.0_dp
-       ! relSpinInc: ΔR = R_{n+1} R_nᵀ, R_n = [c −s; s c] from its plane form
-       rel_spin(e, 1) = plane_relative_spin(spin, n11, n21, n12, n22, r_old(e, 1, 1), r_old(e, 2, 1), &
-            -r_old(e, 2, 1), r_old(e, 1, 1))
+       r_plane(e, 1, 1) = r_new(e, 1, 1)
+       r_plane(e, 2, 1) = r_new(e, 2, 1)
     end do
   end subroutine cpe4r_increment_kinematics
 
@@ -380,7 +365,7 @@ contains
     real(dp), intent(inout) :: fe(nb, 2, 4)
     real(dp), intent(inout) :: force_hg(nb, 2, 1)
     real(dp), intent(out) :: energy_inc(nb), work(nb)
-    real(dp) :: g1, g2, g3, g4, q1, q2, qc1, qc2, h1, h2, qg1, qg2, area, scale, c, dtm
+    real(dp) :: g1, g2, g3, g4, q1, q2, qg1, qg2, area, scale, c, dtm
     integer :: e
 
     dtm = max(dt, tiny(1.0_dp))
@@ -425,18 +410,9 @@ contains
           ! Σ_iI B_iI² (in the order of the node loop)
           scale = 0.25_dp * modulus(e) * volume_mid(e) * bsq(e)
           c = coefficient * scale
-          ! qc = R_{n+½}ᵀ q; Q^c += K qc; qg = R_{n+1} Q^c
-          qc1 = (0.0_dp + rot_mid(e, 1, 1) * q1) + rot_mid(e, 2, 1) * q2
-          qc2 = (0.0_dp + rot_mid(e, 1, 2) * q1) + rot_mid(e, 2, 2) * q2
-          h1 = hg_state(e, 1, 1)
-          h2 = hg_state(e, 2, 1)
-          energy_inc(e) = (0.0_dp + (h1 + 0.5_dp * c * qc1) * qc1) + (h2 + 0.5_dp * c * qc2) * qc2
-          h1 = h1 + c * qc1
-          h2 = h2 + c * qc2
-          hg_state(e, 1, 1) = h1
-          hg_state(e, 2, 1) = h2
-          qg1 = (0.0_dp + rot_new(e, 1, 1) * h1) + rot_new(e, 1, 2) * h2
-          qg2 = (0.0_dp + rot_new(e, 2, 1) * h1) + rot_new(e, 2, 2) * h2
+          call stiffness_mode_force(c, q1, q2, rot_mid(e, 1, 1), rot_mid(e, 2, 1), rot_mid(e, 1, 2), &
+               rot_mid(e, 2, 2), rot_new(e, 1, 1), rot_new(e, 2, 1), rot_new(e, 1, 2), rot_new(e, 2, 2), &
+               hg_state(e, 1, 1), hg_state(e, 2, 1), qg1, qg2, energy_inc(e))
        else
           ! no hourglass control: no force (fe + 0 = fe below), no energy
           qg1 = 0.0_dp
@@ -448,6 +424,25 @@ contains
             force_hg(e, 2, 1), work(e))
     end do
   end subroutine cpe4r_hourglass_update
+
+  !> The stiffness form's generalised force of one element (stiffness c = κ K): qc = R_{n+½}ᵀ q,
+  !> Q^c += c qc (h, the corotational state, in and out), qg = R_{n+1} Q^c, and its energy
+  !> ½ (Q^c_old + Q^c_new)·qc. r_ij: R_{n+½}, n_ij: R_{n+1}.
+  elemental subroutine stiffness_mode_force(c, q1, q2, r11, r21, r12, r22, n11, n21, n12, n22, h1, h2, &
+                                            qg1, qg2, energy)
+    real(dp), intent(in) :: c, q1, q2, r11, r21, r12, r22, n11, n21, n12, n22
+    real(dp), intent(inout) :: h1, h2
+    real(dp), intent(out) :: qg1, qg2, energy
+    real(dp) :: qc1, qc2
+
+    qc1 = (0.0_dp + r11 * q1) + r21 * q2
+    qc2 = (0.0_dp + r12 * q1) + r22 * q2
+    energy = (0.0_dp + (h1 + 0.5_dp * c * qc1) * qc1) + (h2 + 0.5_dp * c * qc2) * qc2
+    h1 = h1 + c * qc1
+    h2 = h2 + c * qc2
+    qg1 = (0.0_dp + n11 * h1) + n12 * h2
+    qg2 = (0.0_dp + n21 * h1) + n22 * h2
+  end subroutine stiffness_mode_force
 
   !> One element's hourglass mode in both loops of cpe4r_hourglass_update: f_iI += Q_i γ_I,
   !> work = ½ (Q_n + Q_{n+1})·q, and Q_{n+1} = Q kept (q_old in, out).

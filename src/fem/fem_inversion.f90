@@ -20,6 +20,7 @@ module fem_inversion
   integer, parameter, public :: inversion_centre = 1    !< volume (centre Jacobian) ≤ 0
   integer, parameter, public :: inversion_corner = 2    !< a corner Jacobian ≤ 0 (tangled/bow-tie)
   integer, parameter, public :: inversion_collapse = 3  !< V/V0 below the collapse limit
+  integer, parameter, public :: inversion_axis = 4      !< CAX4R: a node crossed the axis (r < 0)
   !> Suggested collapse limit for V/V0 (granular compaction stays far above it).
   real(dp), parameter, public :: default_min_volume_ratio = 1.0e-2_dp
 
@@ -133,6 +134,8 @@ contains
        text = 'element tangled: a corner Jacobian <= 0 (bow-tie or folded element)'
     case (inversion_collapse)
        text = 'element collapsed: volume ratio V/V0 below the limit'
+    case (inversion_axis)
+       text = 'axisymmetric element crossed the symmetry axis: a node has r < 0'
     case default
        text = 'unknown inversion reason'
     end select

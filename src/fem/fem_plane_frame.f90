@@ -12,7 +12,7 @@ module fem_plane_frame
   implicit none
   private
 
-  public :: plane_defgrad, plane_rotation, plane_similarity, plane_relative_spin
+  public :: plane_defgrad, plane_rotation, plane_similarity, plane_relative_spin, plane_corotational_step
 
 contains
 
@@ -81,4 +81,26 @@ contains
     d21 = (0.0_dp + n21 * o11) + n22 * o12
     rel_spin = spin - 2.0_dp * (d21 - d12) / max(2.0_dp + d11 + d22, tiny(1.0_dp))
   end function plane_relative_spin
+
+  !> The whole Green–Naghdi step of a 4-node plane element (CPE4R, and CAX4R in its r–z plane):
+  !> F_{n+½}, R_{n+½} (q) from the mid-increment node offsets dm (nodes 2–4 from node 1), F_{n+1}
+  !> (f), R_{n+1} (n) from dn, with the reference mean gradient b; strainInc = R_{n+½}ᵀ Δε R_{n+½}
+  !> of the in-plane global increment (e11, e22, e12 tensor shear) -> (c11, c22, c12); relSpinInc
+  !> from the spin ΔW21 and R_n = [co −so; so co].
+  elemental subroutine plane_corotational_step(dmx2, dmx3, dmx4, dmy2, dmy3, dmy4, dnx2, dnx3, dnx4, &
+       dny2, dny3, dny4, b12, b13, b14, b22, b23, b24, e11, e22, e12, spin, co, so, q11, q21, q12, q22, &
+       f11, f21, f12, f22, n11, n21, n12, n22, c11, c22, c12, rel_spin)
+    real(dp), intent(in) :: dmx2, dmx3, dmx4, dmy2, dmy3, dmy4, dnx2, dnx3, dnx4, dny2, dny3, dny4
+    real(dp), intent(in) :: b12, b13, b14, b22, b23, b24, e11, e22, e12, spin, co, so
+    real(dp), intent(out) :: q11, q21, q12, q22, f11, f21, f12, f22, n11, n21, n12, n22, c11, c22, c12
+    real(dp), intent(out) :: rel_spin
+    real(dp) :: g11, g21, g12, g22
+
+    call plane_defgrad(dmx2, dmx3, dmx4, dmy2, dmy3, dmy4, b12, b13, b14, b22, b23, b24, g11, g21, g12, g22)
+    call plane_rotation(g11, g21, g12, g22, q11, q21, q12, q22)
+    call plane_defgrad(dnx2, dnx3, dnx4, dny2, dny3, dny4, b12, b13, b14, b22, b23, b24, f11, f21, f12, f22)
+    call plane_rotation(f11, f21, f12, f22, n11, n21, n12, n22)
+    call plane_similarity(q11, q21, q12, q22, e11, e22, e12, c11, c22, c12)
+    rel_spin = plane_relative_spin(spin, n11, n21, n12, n22, co, so, -so, co)
+  end subroutine plane_corotational_step
 end module fem_plane_frame

@@ -14,6 +14,7 @@ module scene_geometry
   use keyword_reader, only: keyword_deck_t
   use model, only: model_t
   use scene_mesh, only: mesh_sources_t
+  use model_mesh, only: element_cax4r
   use scene_util, only: itoa, rtoa
   use fem_cpe4r, only: cpe4r_geometry
   use fem_c3d8r, only: c3d8r_geometry
@@ -107,6 +108,16 @@ contains
     ne = model%mesh%nen
     what = merge('area  ', 'volume', nd == 2)
     associate (x => model%mesh%x0, conn => model%mesh%conn)
+      if (model%mesh%element_type == element_cax4r) then
+         do a = 1, ne
+            if (x(1, conn(a, ie)) < 0.0_dp) then
+               text = 'has its node ' // itoa(model%mesh%node_id(conn(a, ie))) // ' at r = ' // &
+                    rtoa(x(1, conn(a, ie))) // ' < 0 (below the symmetry axis); expected every node of ' // &
+                    'an axisymmetric (CAX4R) element at r = x >= 0 (nodes on the axis r = 0 are allowed)'
+               return
+            end if
+         end do
+      end if
       do b = 2, ne
          do a = 1, b - 1
             if (maxval(abs(x(:, conn(a, ie)) - x(:, conn(b, ie)))) <= 0.0_dp) then

@@ -45,7 +45,7 @@ contains
          'SURFACE', 'RIGID BODY', 'SURFACE INTERACTION', 'INITIAL CONDITIONS', 'SECTION CONTROLS', &
          'MPM GRID', 'PARTICLES', 'OUTFLOW')
        keyword_kind = kw_model
-    case ('DYNAMIC', 'DLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'FIXED MASS SCALING', &
+    case ('DYNAMIC', 'DLOAD', 'DSLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'FIXED MASS SCALING', &
           'STOP CONDITION', 'INFLOW', 'TEMPERATURE')
        keyword_kind = kw_step_only
     case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR', 'MPM CONTROLS', 'MPM WALL')

@@ -11,7 +11,7 @@ module scene_mesh
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t
   use model, only: model_t
-  use model_mesh, only: element_cpe4r, element_c3d8r
+  use model_mesh, only: element_cpe4r, element_c3d8r, element_cax4r
   use model_sets, only: name_length
   use scene_layout, only: scene_layout_t
   use scene_sets, only: add_members
@@ -60,9 +60,9 @@ contains
          if (err%raised) return
          call blk%get_string('TYPE', etype, err)
          if (err%raised) return
-         if (etype /= 'CPE4R' .and. etype /= 'C3D8R') then
+         if (etype /= 'CPE4R' .and. etype /= 'C3D8R' .and. etype /= 'CAX4R') then
             call blk%fail('element type ' // etype // ' is not supported; expected TYPE=CPE4R ' // &
-                 '(2D plane strain) or TYPE=C3D8R (3D)', err)
+                 '(2D plane strain), TYPE=CAX4R (axisymmetric, x = r, y = z) or TYPE=C3D8R (3D)', err)
             return
          end if
          if (first == 0) then
@@ -85,6 +85,10 @@ contains
     end if
     if (first_type == 'CPE4R') then
        model%mesh%element_type = element_cpe4r
+       model%mesh%ndim = 2
+       model%mesh%nen = 4
+    else if (first_type == 'CAX4R') then
+       model%mesh%element_type = element_cax4r
        model%mesh%ndim = 2
        model%mesh%nen = 4
     else
@@ -146,7 +150,7 @@ contains
               z = x(3, n)
               if (ndim == 2 .and. abs(z) > 0) then
                  call raise_error(dl%file, dl%line, 'node ' // itoa(id) // ' has z = ' // &
-                      dl%field(4) // ' in a 2D (CPE4R) model; expected x, y (or z = 0)', err)
+                      dl%field(4) // ' in a 2D (CPE4R/CAX4R) model; expected x, y (or z = 0)', err)
                  return
               end if
               call append_int(ids, nb, id)
@@ -241,6 +245,7 @@ contains
 
     nen = model%mesh%nen
     tname = merge('CPE4R', 'C3D8R', nen == 4)
+    if (model%mesh%element_type == element_cax4r) tname = 'CAX4R'
     n = 0
     nb = 0
     ns = 0

@@ -23,7 +23,7 @@ module scene_steps
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_syntax
   use model, only: model_t
   use model_sets, only: find_set, name_length
-  use model_steps, only: step_t, gravity_t, contact_pair_t, mass_scaling_t, mass_scaling_below_min, &
+  use model_steps, only: step_t, gravity_t, pressure_t, contact_pair_t, mass_scaling_t, mass_scaling_below_min, &
        mass_scaling_uniform, temperature_t
   use scene_temperature, only: read_temperature
   use scene_layout, only: scene_layout_t
@@ -31,9 +31,10 @@ module scene_steps
   use scene_boundaries, only: bc_state_t, bc_init, bc_clear, read_boundary, bc_resolve, boundary_op, &
        bc_carry
   use scene_step_continuity, only: warn_gravity_jumps
+  use scene_pressure, only: read_dsload
   use model_time_variation, only: time_variation_t, carry_into_step
   use scene_outputs, only: output_state_t, outputs_step_start, read_output, read_output_option, time_marks
-  use scene_surfaces, only: find_element_surface, find_rigid_surface
+  use scene_surfaces, only: find_rigid_surface, require_element_surface
   use scene_interactions, only: find_interaction
   use scene_util, only: itoa, rtoa, get_real, get_real_param, field_name, field_blank, &
        expect_fields, expect_lines, where_text, check_name
@@ -47,6 +48,8 @@ module scene_steps
      type(bc_state_t) :: bcs
      integer :: n_gravity = 0
      type(gravity_t), allocatable :: gravity(:)
+     integer :: n_pressures = 0
+     type(pressure_t), allocatable :: pressures(:)
      integer :: n_pairs = 0
      type(contact_pair_t), allocatable :: pairs(:)
      type(output_state_t) :: outputs
@@ -72,7 +75,7 @@ contains
     real(dp) :: step_end
 
     call bc_init(c%bcs, model%mesh%n_nodes)
-    allocate (c%gravity(0), c%pairs(0), c%mass_scaling(0), c%temperatures(0))
+    allocate (c%gravity(0), c%pressures(0), c%pairs(0), c%mass_scaling(0), c%temperatures(0))
     do i = 1, deck%n_blocks
        if (layout%step_of(i) /= 0) cycle
        select case (deck%blocks(i)%name)
@@ -105,6 +108,10 @@ contains
              call carry_into_step(c%temperatures(k)%variation, model%amplitudes, model%steps(s - 1)%period, &
                   step_end)
           end do
+          do k = 1, c%n_pressures
+             call carry_into_step(c%pressures(k)%variation, model%amplitudes, model%steps(s - 1)%period, &
+                  step_end)
+          end do
        end if
        call read_step(deck, layout, s, model, c, model%steps(s), err)
        if (err%raised) return
@@ -123,7 +130,7 @@ contains
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: name
     integer :: i, i0, i1, j, n_options, dynamic_block, stop_block
-    logical :: bc_new, dload_new
+    logical :: bc_new, dload_new, dsload_new
 
     i0 = layout%step_block(s)
     i1 = layout%end_block(s)
@@ -145,7 +152,9 @@ contains
 
     call op_new_rule(deck, i0, i1, 'BOUNDARY', bc_new, err)
     if (.not. err%raised) call op_new_rule(deck, i0, i1, 'DLOAD', dload_new, err)
+    if (.not. err%raised) call op_new_rule(deck, i0, i1, 'DSLOAD', dsload_new, err)
     if (err%raised) return
+    if (dsload_new) c%n_pressures = 0
     if (bc_new) call bc_clear(c%bcs)
     if (dload_new) c%n_gravity = 0
     call outputs_step_start(c%outputs)
@@ -170,6 +179,8 @@ contains
             call read_dload(blk, model, c, err)
          case ('TEMPERATURE')
             call read_temperature(blk, model, c%temperatures, c%n_temperatures, err)
+         case ('DSLOAD')
+            call read_dsload(blk, model, c%pressures, c%n_pressures, err)
          case ('CONTACT PAIR')
             call read_contact_pair(blk, model, .true., c, err)
          case ('BULK VISCOSITY')
@@ -223,6 +234,7 @@ contains
     step%mass_scaling = c%mass_scaling(1:c%n_mass_scaling)
     step%gravity = c%gravity(1:c%n_gravity)
     step%temperatures = c%temperatures(1:c%n_temperatures)
+    step%pressures = c%pressures(1:c%n_pressures)
     step%contact_pairs = c%pairs(1:c%n_pairs)
     step%field_outputs = c%outputs%field(1:c%outputs%n_field)
     step%history_outputs = c%outputs%history(1:c%outputs%n_history)
@@ -457,18 +469,10 @@ contains
          if (err%raised) return
          slave = field_name(dl, 1)
          master = field_name(dl, 2)
-         ks = find_element_surface(model, slave)
+         call require_element_surface(model, dl, slave, 'a rigid surface; expected the element ' // &
+              'surface first and the rigid surface second', ks, err)
+         if (err%raised) return
          km = find_rigid_surface(model, master)
-         if (ks == 0) then
-            if (find_rigid_surface(model, slave) /= 0) then
-               call raise_error(dl%file, dl%line, 'surface ' // slave // ' is a rigid surface; expected ' // &
-                    'the element surface first and the rigid surface second', err)
-            else
-               call raise_error(dl%file, dl%line, 'surface ' // slave // ' is not defined; expected the ' // &
-                    'name of a *SURFACE, TYPE=ELEMENT', err)
-            end if
-            return
-         end if
          if (km == 0) then
             call raise_error(dl%file, dl%line, 'surface ' // master // ' is not a rigid surface; ' // &
                  'expected the name of a *SURFACE, TYPE=SEGMENTS or TYPE=PLANE', err)

@@ -15,7 +15,8 @@ module scene_surfaces
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_text
   use model, only: model_t
   use model_sets, only: find_set, name_length
-  use model_surfaces, only: element_surface_t, rigid_surface_t, segment_t, segment_line, segment_arc
+  use model_surfaces, only: element_surface_t, rigid_surface_t, segment_t, segment_line, segment_arc, &
+       cpe4r_faces, c3d8r_faces
   use scene_layout, only: scene_layout_t
   use scene_sets, only: elem_targets
   use scene_util, only: itoa, rtoa, get_real, field_name, expect_fields, expect_lines, &
@@ -23,12 +24,8 @@ module scene_surfaces
   implicit none
   private
 
-  public :: build_surfaces, build_rigid_bodies, find_element_surface, find_rigid_surface
+  public :: build_surfaces, build_rigid_bodies, find_element_surface, find_rigid_surface, require_element_surface
 
-  !> Abaqus face numbering: local nodes of face S1..S4 of CPE4R and S1..S6 of C3D8R.
-  integer, parameter :: cpe4r_faces(2, 4) = reshape([1, 2, 2, 3, 3, 4, 4, 1], [2, 4])
-  integer, parameter :: c3d8r_faces(4, 6) = reshape([1, 2, 3, 4, 5, 8, 7, 6, 1, 5, 6, 2, &
-       2, 6, 7, 3, 3, 7, 8, 4, 4, 8, 5, 1], [4, 6])
 
   !> Relative tolerance on the two radii of a CIRCL segment (coordinates typed with a
   !> few digits, e.g. 0.7071 for sqrt(1/2), must pass).
@@ -379,4 +376,23 @@ contains
        end associate
     end do
   end subroutine build_rigid_bodies
+
+  !> k = the element surface `name` of data line dl, or an error at dl: "is a rigid surface"
+  !> followed by `rigid_expected` when it names a rigid surface, else "is not defined".
+  subroutine require_element_surface(model, dl, name, rigid_expected, k, err)
+    type(model_t), intent(in) :: model
+    type(data_line_t), intent(in) :: dl
+    character(len=*), intent(in) :: name, rigid_expected
+    integer, intent(out) :: k
+    type(error_t), intent(inout) :: err
+
+    k = find_element_surface(model, name)
+    if (k > 0) return
+    if (find_rigid_surface(model, name) /= 0) then
+       call raise_error(dl%file, dl%line, 'surface ' // name // ' is ' // rigid_expected, err)
+    else
+       call raise_error(dl%file, dl%line, 'surface ' // name // ' is not defined; expected the ' // &
+            'name of a *SURFACE, TYPE=ELEMENT', err)
+    end if
+  end subroutine require_element_surface
 end module scene_surfaces

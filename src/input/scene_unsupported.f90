@@ -34,10 +34,10 @@ contains
          'SOLID SECTION COMPOSITE', 'INFINITE SECTION', 'TRUSS SECTION', 'ORIENTATION', 'NORMAL', 'TRANSFORM', &
          'SYSTEM', 'HOURGLASS STIFFNESS', 'TRANSVERSE SHEAR STIFFNESS')
        hint = 'bulkflow has continuum elements only (CPE4R, C3D8R, *SOLID SECTION) in global axes'
-    case ('CLOAD', 'DSLOAD', 'CFLUX', 'DFLUX', 'DSFLUX', 'FILM', 'SFILM', 'RADIATE', 'FIELD', &
+    case ('CLOAD', 'CFLUX', 'DFLUX', 'DSFLUX', 'FILM', 'SFILM', 'RADIATE', 'FIELD', &
          'CONNECTOR LOAD', 'CONNECTOR MOTION', 'BASE MOTION', 'INERTIA RELIEF', 'PRESSURE STRESS', 'DSECURRENT', &
          'CECHARGE', 'DECHARGE', 'CSLOAD', 'CORRELATION', 'MOTION', 'CHANGE FRICTION', 'MODEL CHANGE')
-       hint = 'bulkflow offers gravity (*DLOAD, GRAV), prescribed displacements and velocities (*BOUNDARY) ' // &
+       hint = 'bulkflow offers gravity (*DLOAD, GRAV), pressure on element surfaces (*DSLOAD, P), prescribed displacements and velocities (*BOUNDARY) ' // &
             'and moving rigid walls (*RIGID BODY + *BOUNDARY on its reference node)'
     case ('EQUATION', 'MPC', 'TIE', 'COUPLING', 'KINEMATIC COUPLING', 'DISTRIBUTING COUPLING', 'KINEMATIC', &
          'DISTRIBUTING', 'CONNECTOR BEHAVIOR', 'SHELL TO SOLID COUPLING', 'CONTACT INTERFERENCE', 'CLEARANCE', &

@@ -9,13 +9,14 @@ module model_mesh
 
   integer, parameter, public :: element_cpe4r = 1
   integer, parameter, public :: element_c3d8r = 2
+  integer, parameter, public :: element_cax4r = 3  !< 2D axisymmetric, x = r, y = z
 
   type, public :: mesh_t
      integer :: ndim = 0                      !< 2 (plane strain) or 3
      integer :: n_nodes = 0
      real(dp), allocatable :: x0(:, :)        !< (ndim, n_nodes) reference coordinates
      integer, allocatable :: node_id(:)       !< user node number of each internal node
-     integer :: element_type = 0              !< element_cpe4r or element_c3d8r
+     integer :: element_type = 0              !< element_cpe4r, element_c3d8r or element_cax4r
      integer :: nen = 0                       !< nodes per element: 4 or 8
      integer :: n_elems = 0
      integer, allocatable :: conn(:, :)       !< (nen, n_elems) internal node indices

@@ -43,6 +43,14 @@ module model_steps
      type(time_variation_t) :: variation      !< amplitude, or held from an earlier step
      character(len=256) :: source = ''
   end type temperature_t
+  !> *DSLOAD, P: uniform pressure on the faces of an element surface (a follower load, on the
+  !> current geometry; positive pushes into the elements, as in Abaqus).
+  type, public :: pressure_t
+     integer :: surface = 0                   !< element surface index (model%element_surfaces)
+     real(dp) :: magnitude = 0
+     type(time_variation_t) :: variation      !< amplitude, or held from an earlier step
+     character(len=256) :: source = ''        !< file:line of the *DSLOAD data line
+  end type pressure_t
 
   !> *SURFACE INTERACTION + *FRICTION.
   type, public :: interaction_t
@@ -116,6 +124,7 @@ module model_steps
      type(boundary_t), allocatable :: boundaries(:)
      type(gravity_t), allocatable :: gravity(:)
      type(temperature_t), allocatable :: temperatures(:)
+     type(pressure_t), allocatable :: pressures(:)
      type(contact_pair_t), allocatable :: contact_pairs(:)
      type(field_output_t), allocatable :: field_outputs(:)
      type(history_output_t), allocatable :: history_outputs(:)

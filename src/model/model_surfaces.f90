@@ -9,6 +9,13 @@ module model_surfaces
   integer, parameter, public :: segment_line = 1
   integer, parameter, public :: segment_arc = 2
 
+  !> Abaqus face numbering: local nodes of face S1..S4 of CPE4R/CAX4R and S1..S6 of C3D8R. In
+  !> this order (ξ from the first node to the second, η from the first to the last), the face's
+  !> x_ξ × x_η (3D) or the edge's left normal (2D) points into the element.
+  integer, parameter, public :: cpe4r_faces(2, 4) = reshape([1, 2, 2, 3, 3, 4, 4, 1], [2, 4])
+  integer, parameter, public :: c3d8r_faces(4, 6) = reshape([1, 2, 3, 4, 5, 8, 7, 6, 1, 5, 6, 2, &
+       2, 6, 7, 3, 3, 7, 8, 4, 4, 8, 5, 1], [4, 6])
+
   !> *SURFACE, TYPE=ELEMENT: faces S1..S4 (CPE4R) or S1..S6 (C3D8R) of listed elements.
   type, public :: element_surface_t
      character(len=name_length) :: name = ''

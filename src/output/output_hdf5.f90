@@ -3,7 +3,7 @@
 !>
 !> Layout (full description in docs/output_format.md; shapes as h5py/C show them):
 !>   /                      attributes format = "bulkflow-fields", format_version = 1
-!>   /mesh                  attributes ndim, nen, element_type ("CPE4R" | "C3D8R")
+!>   /mesh                  attributes ndim, nen, element_type ("CPE4R" | "CAX4R" | "C3D8R")
 !>   /mesh/coordinates      (n_nodes, 3) float64, reference configuration, z = 0 in 2D
 !>   /mesh/connectivity     (n_elems, nen) int32, 0-based global node indices (XDMF's convention)
 !>   /mesh/node_id          (n_nodes,) int32, user node numbers
@@ -36,7 +36,7 @@ module output_hdf5
   use hdf5
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use model_mesh, only: element_cpe4r, element_c3d8r
+  use model_mesh, only: element_cpe4r, element_c3d8r, element_cax4r
   use output_files, only: base_name, int_to_str, file_exists
   use output_collective, only: agree_on_error
   use output_xdmf, only: xdmf_mesh_t, xdmf_frame_t, xdmf_write, xdmf_add_attribute, &
@@ -133,6 +133,9 @@ contains
     case (element_cpe4r)
        w%mesh%topology = 'Quadrilateral'
        if (ndim /= 2 .or. w%nen /= 4) call fail('CPE4R needs ndim = 2 and 4 nodes per element')
+    case (element_cax4r)
+       w%mesh%topology = 'Quadrilateral'
+       if (ndim /= 2 .or. w%nen /= 4) call fail('CAX4R needs ndim = 2 and 4 nodes per element')
     case (element_c3d8r)
        w%mesh%topology = 'Hexahedron'
        if (ndim /= 3 .or. w%nen /= 8) call fail('C3D8R needs ndim = 3 and 8 nodes per element')
@@ -460,6 +463,8 @@ contains
     call write_attr_int(group, 'nen', w%nen)
     if (element_type == element_cpe4r) then
        call write_attr_string(group, 'element_type', 'CPE4R')
+    else if (element_type == element_cax4r) then
+       call write_attr_string(group, 'element_type', 'CAX4R')
     else
        call write_attr_string(group, 'element_type', 'C3D8R')
     end if

@@ -48,7 +48,7 @@ def expected_effects(scene: Path) -> tuple[list[str], list[str]]:
                 and not line.startswith('**')}
     present = ['elements', 'material', 'hourglass', 'assembly', 'output']
     absent = []
-    for effect, keyword in (('rigid walls', '*CONTACT PAIR'), ('user field', '*USER DEFINED FIELD'),
+    for effect, keyword in (('pressure', '*DSLOAD'), ('rigid walls', '*CONTACT PAIR'), ('user field', '*USER DEFINED FIELD'),
                             ('gravity', '*DLOAD'), ('checkpoint', '*RESTART'), ('boundary', '*BOUNDARY')):
         (present if keyword in keywords else absent).append(effect)
     return present, absent
@@ -126,7 +126,8 @@ def check_column(p, run: Run) -> dict[str, float]:
     yc = fields.centroids()[:, vert]
     inner = (yc > 0.2 * height) & (yc < 0.8 * height)
     s = last.fields['S'][inner]
-    sv_exact = -rho * grav * (height - yc[inner])
+    q = float(p.get('surcharge', 0.0))        # *DSLOAD pressure on the top
+    sv_exact = -rho * grav * (height - yc[inner]) - q
     sv = s[:, vert]
     horizontal = [0, 2] if ndim == 2 else [0, 1]
     k0 = lam / m
@@ -134,13 +135,13 @@ def check_column(p, run: Run) -> dict[str, float]:
     sv_error = np.max(np.abs(sv / sv_exact - 1))
     h = read_history(run.history_csv)
     top = h[f'U{ndim}_TOP'][-1]
-    top_exact = -rho * grav * height ** 2 / (2 * m)
+    top_exact = -(rho * grav * height ** 2 / 2 + q * height) / m
     print(f'  {inner.sum()} elements with 0.2 H < y < 0.8 H at t = {last.total_time:.4g} s; K0 = {k0:.5f}; '
           f'top settlement {top:.5e} m (closed form {top_exact:.5e})')
     figures = {'k0': float(k0_error), 'sigma_v': float(sv_error), 'settlement': float(top / top_exact - 1)}
     report('K0 error max |sigma_h/sigma_v - nu/(1-nu)|/K0', 100 * figures['k0'], 1.0, ' %')
-    report('vertical stress error max |sigma_v/(-rho g (H-y)) - 1|', 100 * figures['sigma_v'], 2.0, ' %')
-    report('top settlement error vs rho g H^2/(2M)', 100 * figures['settlement'], 2.0, ' %')
+    report('vertical stress error max |sigma_v/(-rho g (H-y) - q) - 1|', 100 * figures['sigma_v'], 2.0, ' %')
+    report('top settlement error vs (rho g H^2/2 + q H)/M', 100 * figures['settlement'], 2.0, ' %')
     return figures
 
 
@@ -213,6 +214,8 @@ def check_patch(p, run: Run) -> dict[str, float]:
     # (logarithmic) strain is log(F); sigma = lambda tr E I + 2 G E.
     f3 = np.eye(3)
     f3[:ndim, :ndim] += grad * t
+    if p.get('axisymmetric') == 'yes':
+        f3[2, 2] += grad[0, 0] * t              # hoop stretch r/R = 1 + a t of u_r = a r t
     w, q = np.linalg.eigh(f3)
     strain = q @ np.diag(np.log(w)) @ q.T
     sig = lam * np.trace(strain) * np.eye(3) + 2 * g * strain
@@ -310,7 +313,53 @@ def check_sections(p, run: Run) -> dict[str, float]:
     return {'returned': float(drop)}
 
 
-CHECKS = {'wave': check_wave, 'column': check_column, 'incline': check_incline, 'patch': check_patch,
+def check_lame(p, run: Run) -> dict[str, float]:
+    """Thick-walled cylinder, plane strain, internal pressure p, outer surface free (Lame;
+    docs/theory/elements.md §3.10): u = A r + B/r, sigma_r = 2(lam+G)A - 2G B/r^2,
+    sigma_theta = 2(lam+G)A + 2G B/r^2, sigma_z = 2 lam A; sigma_r(a) = -p, sigma_r(b) = 0:
+    A = p a^2 / (2 (lam+G)(b^2 - a^2)), B = p a^2 b^2 / (2 G (b^2 - a^2))."""
+    lam, g, m, c = moduli(p)
+    a, b, pressure = float(p['inner']), float(p['outer']), float(p['pressure'])
+    big_a = pressure * a ** 2 / (2 * (lam + g) * (b ** 2 - a ** 2))
+    big_b = pressure * a ** 2 * b ** 2 / (2 * g * (b ** 2 - a ** 2))
+    u_a = big_a * a + big_b / a
+    fields = read_fields(run.h5)
+    last = fields.frames[-1]
+    r = fields.centroids()[:, 0]
+    s = last.fields['S']
+    sr_exact = 2 * (lam + g) * big_a - 2 * g * big_b / r ** 2
+    st_exact = 2 * (lam + g) * big_a + 2 * g * big_b / r ** 2
+    rn = fields.x0[:, 0]
+    u_exact = big_a * rn + big_b / rn
+    figures = {'sigma_r': float(np.max(np.abs(s[:, 0] - sr_exact)) / pressure),
+               'sigma_theta': float(np.max(np.abs(s[:, 2] - st_exact)) / pressure),
+               'sigma_z': float(np.max(np.abs(s[:, 1] - 2 * lam * big_a)) / pressure),
+               'u_r': float(np.max(np.abs(last.fields['U'][:, 0] - u_exact)) / u_a)}
+    print(f'  {len(s)} elements, bore pressure p = {pressure:.5e} Pa, hoop stress at the bore '
+          f'{st_exact.max():.5e} Pa, t = {last.total_time:.4g} s')
+    report('radial stress error max |sigma_r - Lame| / p', 100 * figures['sigma_r'], 1.0, ' %')
+    report('hoop stress error max |sigma_theta - Lame| / p', 100 * figures['sigma_theta'], 1.0, ' %')
+    report('axial stress error max |sigma_z - 2 lam A| / p', 100 * figures['sigma_z'], 1.0, ' %')
+    report('radial displacement error max |u_r - (A r + B/r)| / u_a', 100 * figures['u_r'], 1.0, ' %')
+    return figures
+
+
+def check_floor(p, run: Run) -> dict[str, float]:
+    """A body at rest on a rigid floor after the gravity ramp: the floor carries its weight m g
+    (the second half of the history rows after the ramp)."""
+    mass, grav, ramp = float(p['mass']), float(p['g']), float(p['ramp'])
+    h = read_history(run.history_csv)
+    wall = [k for k in h if k.startswith('WALLF2_')][0]
+    t = h['time']
+    settled = t > ramp + 0.5 * (t[-1] - ramp)
+    force = h[wall][settled]
+    figures = {'weight': float(np.max(np.abs(force / (-mass * grav) - 1)))}
+    print(f'  {wall}: mean {force.mean():.6e} N over {settled.sum()} rows; weight m g = {mass * grav:.6e} N')
+    report('floor force vs the weight of the full ring, worst row', 100 * figures['weight'], 1.0, ' %')
+    return figures
+
+
+CHECKS = {'floor': check_floor, 'lame': check_lame, 'wave': check_wave, 'column': check_column, 'incline': check_incline, 'patch': check_patch,
           'dynamic': check_dynamic, 'sections': check_sections, 'rotation': check_rotation,
           'plastic_patch': check_plastic_patch}
 

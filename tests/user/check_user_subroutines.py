@@ -13,6 +13,7 @@ Cases
   probe_c3d8r_rotation  one C3D8R element: stretch, then a rotation of 40 degrees about (1,2,3)
   probe_cpe4r_block     12 x 12 CPE4R (144 elements: one solver block, two VUMAT calls)
   probe_c3d8r_block     6 x 6 x 4 C3D8R (144 elements)
+  probe_cax4r_block     4 x 4 CAX4R from the axis: u_r = a r, u_z = c z (hoop stretch 1 + a in F33, U33)
   probe_mpm             an MPM column settling under gravity (400 particles; temperature and
                         two field variables from *INITIAL CONDITIONS on the material's particles)
   probe_matpoint        bulkflow-matpoint oedometer test
@@ -85,7 +86,7 @@ def props_line(xc, check_coord: bool, nfieldv: int, rate: float = 0.0) -> str:
 
 
 def element_scene(path: Path, ndim: int, n: tuple, stretch, axis, angle: float, total: float,
-                  temp_rate: float = 0.0):
+                  temp_rate: float = 0.0, etype: str | None = None):
     """A homogeneous motion x = A(t) X of every node: stretch D over the first half, then the
     rotation R over the second; with temp_rate, *TEMPERATURE, AMPLITUDE= makes the nodes'
     temperature T0 + temp_rate t. Returns the final A and the reference centroids."""
@@ -121,13 +122,13 @@ def element_scene(path: Path, ndim: int, n: tuple, stretch, axis, angle: float, 
 
     lines = ['*HEADING', f'probe VUMAT, {ndim}D, homogeneous motion', '*NODE']
     lines += [f'{k + 1}, ' + ', '.join(repr(float(v)) for v in c) for k, c in enumerate(coords)]
-    etype = 'CPE4R' if ndim == 2 else 'C3D8R'
+    etype = etype or ('CPE4R' if ndim == 2 else 'C3D8R')
     lines.append(f'*ELEMENT, TYPE={etype}, ELSET=ALL')
     lines += [f'{k + 1}, ' + ', '.join(str(v) for v in e) for k, e in enumerate(elems)]
     lines.append('*NSET, NSET=NALL, GENERATE')
     lines.append(f'1, {coords.shape[0]}, 1')
     lines.append('*SOLID SECTION, ELSET=ALL, MATERIAL=PROBE-NEO')
-    if ndim == 2:
+    if etype == 'CPE4R':
         lines.append('1.0')
     single = len(elems) == 1
     lines += ['*MATERIAL, NAME=probe-neo', '*DENSITY', repr(RHO), '*USER MATERIAL, CONSTANTS=12',
@@ -187,12 +188,12 @@ def check_close(name: str, got, want, tol: float):
         raise Failed(f'{name}: error {err:.3e} above {tol:.1e}')
 
 
-def probe_elements(a, ndim: int, n: tuple, stretch, axis, angle: float):
+def probe_elements(a, ndim: int, n: tuple, stretch, axis, angle: float, etype: str | None = None):
     work = a.work
     work.mkdir(parents=True, exist_ok=True)
     scene = work / 'probe.inp'
     total = 0.05
-    f, centroids = element_scene(scene, ndim, n, stretch, axis, angle, total, temp_rate=TRATE)
+    f, centroids = element_scene(scene, ndim, n, stretch, axis, angle, total, temp_rate=TRATE, etype=etype)
     run([a.bulkflow, str(scene), '--quiet', '--user', str(HERE / 'probe_vumat.f')], work)
     fr = last_frame(work / 'probe.h5', 'frames')
     s_want = neo_hooke(f)
@@ -460,6 +461,8 @@ def main() -> int:
                                                        math.radians(40)),
         'probe_cpe4r_block': lambda: probe_elements(a, 2, (12, 12), [0.02, -0.01, 0], [0, 0, 1], 0.0),
         'probe_c3d8r_block': lambda: probe_elements(a, 3, (6, 6, 4), [0.02, -0.01, 0.015], [0, 0, 1], 0.0),
+        # CAX4R (x = r): the stretch's third entry is the hoop stretch u_r/r = a of u_r = a r
+        'probe_cax4r_block': lambda: probe_elements(a, 2, (4, 4), [0.02, -0.01, 0.02], [0, 0, 1], 0.0, 'CAX4R'),
         'probe_mpm': lambda: probe_mpm(a),
         'probe_matpoint': lambda: probe_matpoint(a),
         'single_file_elements': lambda: single_file_elements(a),
