@@ -135,8 +135,8 @@ def set_lines(name: str, members: list[int]) -> list[str]:
 # ---------------------------------------------------------------------------------------------
 # bulkflow deck (CPE4R, explicit)
 
-def bulkflow_deck(mesh: Mesh, phi: float, psi: float, rough: bool, period: float, dt_target: float,
-                  hourglass: str) -> str:
+def bulkflow_deck(mesh: Mesh, phi: float, psi: float, rough: bool, settlement: float, period: float,
+                  dt_target: float, hourglass: str) -> str:
     ident, nodes = grid_nodes(mesh.xs, mesh.ys)
     out = ["*HEADING", f"strip footing, weightless Mohr-Coulomb soil phi {phi:g} psi {psi:g}, "
            f"{'rough' if rough else 'smooth'} footing (scripts/footing_study.py)", "*NODE"]
@@ -160,7 +160,7 @@ def bulkflow_deck(mesh: Mesh, phi: float, psi: float, rough: bool, period: float
             "*BOUNDARY", "SYMM, 1, 1", "RIGHT, 1, 1", "BOTTOM, 1, 2",
             "*STEP, NAME=LOAD", "*DYNAMIC, EXPLICIT", f", {period!r}",
             f"*FIXED MASS SCALING, TYPE=BELOW MIN, DT={dt_target!r}",
-            "*BOUNDARY, AMPLITUDE=PUSH", f"FOOT, 2, 2, {-SETTLEMENT!r}"]
+            "*BOUNDARY, AMPLITUDE=PUSH", f"FOOT, 2, 2, {-settlement!r}"]
     if rough:
         out.append("FOOT, 1, 1")
     out += ["*OUTPUT, FIELD, NUMBER INTERVAL=4", "*NODE OUTPUT", "U, RF",
@@ -193,6 +193,8 @@ class Result:
     curve: Curve = field(default_factory=Curve)
     notes: list[str] = field(default_factory=list)
     ok: bool = True
+    energy: tuple[float, float, float] = (math.nan, math.nan, math.nan)   # balance, ALLAE/ALLIE, KE
+    jump: float = math.nan          # largest row-to-row change of q in the second half / q_u
 
 
 def plateau_value(curve: Curve) -> tuple[float, float]:
@@ -214,7 +216,8 @@ def run_bulkflow(mesh: Mesh, phi: float, psi: float, args, work: Path) -> Result
     dt_target = args.dt_factor * (B_HALF / mesh.nf) / wave_speed()
     name = f"bulkflow_phi{phi:g}_psi{psi:g}_nf{mesh.nf}"
     deck = work / f"{name}.inp"
-    deck.write_text(bulkflow_deck(mesh, phi, psi, args.rough, period, dt_target, args.hourglass))
+    deck.write_text(bulkflow_deck(mesh, phi, psi, args.rough, args.settlement * B_HALF, period, dt_target,
+                                 args.hourglass))
     base = work / name
     t0 = time.perf_counter()
     proc = subprocess.run([args.bulkflow, str(deck), "--output", str(base), "--quiet"],
@@ -286,8 +289,8 @@ def ccx_material(phi: float, psi: float, elastic_tangent: bool) -> tuple[str, li
     return name, lines
 
 
-def ccx_deck(mesh: Mesh, phi: float, psi: float, rough: bool, step: str, elastic_tangent=False,
-             tolerances: str | None = None) -> str:
+def ccx_deck(mesh: Mesh, phi: float, psi: float, rough: bool, settlement: float, step: str,
+             elastic_tangent=False, tolerances: str | None = None) -> str:
     out = ["*HEADING", f"strip footing, weightless MC soil phi {phi:g} psi {psi:g}, bulkflow UMAT"]
     lines, sets = ccx_mesh_lines(mesh)
     out += lines
@@ -299,7 +302,7 @@ def ccx_deck(mesh: Mesh, phi: float, psi: float, rough: bool, step: str, elastic
                   "*STEP, INC=2000"] + step.splitlines()
     if tolerances:
         out += tolerances.splitlines()
-    out += ["*BOUNDARY", f"FOOT, 2, 2, {-SETTLEMENT!r}"]
+    out += ["*BOUNDARY", f"FOOT, 2, 2, {-settlement!r}"]
     if rough:
         out.append("FOOT, 1, 1")
     out += ["*NODE PRINT, NSET=FOOT, TOTALS=ONLY", "RF", "*END STEP"]
@@ -347,14 +350,19 @@ def run_ccx_deck(ccx: str, work: Path, job: str, deck: str) -> tuple[float, str,
 def run_ccx(mesh: Mesh, phi: float, psi: float, args, work: Path) -> Result:
     res = Result("ccx", phi, psi, mesh=mesh.describe().replace("el.", "CPE8R"))
     job = f"ccx_phi{phi:g}_psi{psi:g}_nf{mesh.nf}"
-    step = "*STATIC\n0.02, 1., 1.e-5, 0.02"
-    res.wall, stdout, proc = run_ccx_deck(args.ccx, work, job, ccx_deck(mesh, phi, psi, args.rough, step))
+    step = "*STATIC\n0.02, 1., 1.e-7, 0.02"
+    # Non-associated flow: ccx symmetrises DDSDDE, so Newton converges only linearly; let it
+    # iterate (I_C = 60 iterations, I_A = 30 non-decreasing ones) before cutting the increment.
+    controls = "*CONTROLS, PARAMETERS=TIME INCREMENTATION\n4, 8, 9, 60, 10, 4, 0, 30" if psi < phi else None
+    res.wall, stdout, proc = run_ccx_deck(args.ccx, work, job,
+                                          ccx_deck(mesh, phi, psi, args.rough, args.settlement * B_HALF, step,
+                                                   tolerances=controls))
     totals = ccx_totals(work / f"{job}.dat") if (work / f"{job}.dat").exists() else []
     if proc.returncode != 0 or "*ERROR" in stdout or not totals:
         res.ok = False
         res.notes.append(f"ccx failed (log {job}.log)")
         return res
-    res.curve.settlement = [t * SETTLEMENT for t, _ in totals]
+    res.curve.settlement = [t * args.settlement * B_HALF for t, _ in totals]
     res.curve.pressure = [-fy / B_HALF for _, fy in totals]
     if abs(totals[-1][0] - 1.0) > 1e-9:
         res.ok = False
@@ -371,18 +379,19 @@ def newton_study(args, work: Path) -> None:
     consistent tangent and with the elastic one, for the increments where the soil yields."""
     phi = args.phi[0]
     mesh = make_mesh(phi, args.newton_nf, args.ratio)
-    step = "*STATIC, DIRECT\n0.05, 1."
+    step = "*STATIC, DIRECT\n0.1, 1."
     # Tight residual tolerances so that the iterations go on to round-off; up to 400 iterations
     # per increment for the elastic tangent (I_C and I_A of *CONTROLS, TIME INCREMENTATION).
     tol = ("*CONTROLS, PARAMETERS=TIME INCREMENTATION\n4, 8, 9, 400, 10, 4, 0, 400\n"
            "*CONTROLS, PARAMETERS=FIELD\n1.e-10, 1.e-10, 0., 0., 0.02, 1.e-5, 1.e-3, 1.e-8")
     print(f"Newton in ccx: phi = psi = {phi:g} deg (associated), {mesh.describe()}, "
-          f"20 fixed increments of {SETTLEMENT / 20:g} m")
+          f"10 fixed increments of {args.newton_fraction * args.settlement * B_HALF / 10:g} m")
     runs = {}
     for label, elastic in (("consistent", False), ("elastic", True)):
         job = f"newton_{label}_phi{phi:g}"
         wall, stdout, proc = run_ccx_deck(args.ccx, work, job,
-                                          ccx_deck(mesh, phi, phi, args.rough, step, elastic, tol))
+                                          ccx_deck(mesh, phi, phi, args.rough, args.settlement * B_HALF * args.newton_fraction,
+                                                   step, elastic, tol))
         if proc.returncode != 0 or "*ERROR" in stdout:
             print(f"  {label} tangent: ccx failed (log {work / job}.log)")
         runs[label] = (residual_sequences(stdout), wall)
@@ -419,9 +428,9 @@ def plot(results: list[Result], path: str) -> None:
     fig.savefig(path, dpi=90)
 
 
-def main() -> int:
-    global SETTLEMENT
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--phi", type=float, nargs="+", default=[20.0, 30.0])
     ap.add_argument("--psi", choices=["both", "zero", "assoc"], default="both")
     ap.add_argument("--solver", choices=["both", "bulkflow", "ccx"], default="both")
@@ -439,13 +448,18 @@ def main() -> int:
     ap.add_argument("--plot", help="write the load-settlement curves to this PNG")
     ap.add_argument("--newton", action="store_true", help="only the Newton study in ccx (see above)")
     ap.add_argument("--newton-nf", type=int, default=4)
-    ap.add_argument("--newton-increments", type=int, nargs="+", default=[4, 8, 12])
+    ap.add_argument("--newton-increments", type=int, nargs="+", default=[6, 8, 10])
+    ap.add_argument("--newton-fraction", type=float, default=0.2,
+                    help="the Newton study pushes this fraction of --settlement (before collapse)")
     ap.add_argument("--tolerance", type=float, default=0.05,
                     help="exit 1 when an associated run's |q_u/c - N_c|/N_c exceeds this")
     ap.add_argument("--settlement", type=float, default=SETTLEMENT / B_HALF,
                     help="footing settlement at the end of the push, in units of b")
-    args = ap.parse_args()
-    SETTLEMENT = args.settlement * B_HALF
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
     work = Path(args.work).resolve()
     work.mkdir(parents=True, exist_ok=True)
     solvers = ["bulkflow", "ccx"] if args.solver == "both" else [args.solver]
@@ -472,7 +486,7 @@ def main() -> int:
 
     print()
     print(f"Strip footing, weightless soil, c = {COHESION / 1e3:g} kPa, E = {YOUNG / 1e6:g} MPa, "
-          f"nu = {POISSON}, {'rough' if args.rough else 'smooth'} footing, settlement {SETTLEMENT / B_HALF:g} b")
+          f"nu = {POISSON}, {'rough' if args.rough else 'smooth'} footing, settlement {args.settlement:g} b")
     print("| phi | psi | N_c theory | ccx q_u/c | error | ccx wall s | bulkflow q_u/c | error | bulkflow wall s | mesh |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     failed = False
