@@ -26,6 +26,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 import footing_study as fs  # noqa: E402
 
 SKIP = 77
+# Largest (max q - min q)/q_u on the plateau: associated flow gives a flat plateau (measured 1-2 %
+# with the decaying overshoot of the collapse); psi = 0 a load that wanders about its limit as
+# shear bands re-form (measured about 10 %; less with a slower push, docs/footing.md).
+SPREAD = {True: 0.04, False: 0.20}
 
 
 def check(name, ok, text):
@@ -33,14 +37,15 @@ def check(name, ok, text):
     return ok
 
 
-def stable(r) -> bool:
+def stable(r, spread_limit: float) -> bool:
     balance, hourglass, _ = r.energy
-    figures = [r.q_u, balance, hourglass, r.jump] + r.curve.pressure + r.curve.settlement
+    figures = [r.q_u, balance, hourglass, r.spread] + r.curve.pressure + r.curve.settlement
     good = check("finite", all(math.isfinite(x) for x in figures), "every figure of the run")
     good &= check("energy balance", balance <= 0.01, f"max |ETOTAL| / max energy = {100 * balance:.3f} % (limit 1 %)")
     good &= check("hourglass", hourglass <= 0.02, f"ALLAE/ALLIE = {100 * hourglass:.2f} % (limit 2 %)")
-    good &= check("smooth load", r.jump <= 0.05,
-                  f"largest row-to-row change of q in the second half = {100 * r.jump:.2f} % of q_u (limit 5 %)")
+    good &= check("steady load", r.spread <= spread_limit,
+                  f"(max q - min q)/q_u over the last 30 % of the push = {100 * r.spread:.2f} % "
+                  f"(limit {100 * spread_limit:g} %)")
     return good
 
 
@@ -68,7 +73,7 @@ def main() -> int:
                 print("FAIL: the run did not finish")
                 return 1
             runs[psi] = r
-            good &= stable(r)
+            good &= stable(r, SPREAD[psi == phi])
         err = runs[phi].q_u / fs.COHESION / nc - 1
         good &= check("associated q_u", abs(err) <= 0.07, f"(q_u/c - N_c)/N_c = {100 * err:+.2f} % (limit 7 %)")
         ratio = runs[0.0].q_u / fs.COHESION / nc
