@@ -6,11 +6,12 @@
 
 bulkflow: phi = 30 deg, CPE4R, 8 elements across the footing half-width (912 elements), the
 associated run (psi = phi) and the non-associated one (psi = 0). The associated q_u/c must lie
-within 7 % of N_c = 30.14 (measured +4.9 % on this mesh; the error falls with the mesh, +4.3 % at
-b/16, and stays positive: docs/footing.md), the non-associated q_u must lie below the associated
-one and above 0.7 N_c (measured 0.80 N_c). Both runs must stay stable: energy balance within 1 %
-of the largest energy, hourglass energy under 2 % of the internal energy, no row-to-row jump of
-the load over 5 % of q_u in the second half of the push, every figure finite.
+within 6 % of N_c = 30.14 (measured +3.5 % on this mesh; the error is the mesh's, positive and
+falling under refinement: +4.7 % at b/4, +2.9 % at b/16, docs/footing.md); the non-associated
+q_u must lie between Davis's reduced-strength estimate (20.08 c) and the associated q_u
+(measured 25.2 c). Both runs must stay stable: energy balance within 1 % of the largest energy,
+hourglass energy under 2 % of the internal energy, the load's spread over the plateau bounded
+(SPREAD), every figure finite.
 
 ccx: phi = psi = 30 deg, CPE8R with 4 elements across b (442 elements, CalculiX with our UMAT):
 q_u/c within 5 % of N_c (measured +3.3 %), the push completed. Exit 77 (ctest SKIP) with a plain
@@ -26,10 +27,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 import footing_study as fs  # noqa: E402
 
 SKIP = 77
-# Largest (max q - min q)/q_u on the plateau: associated flow gives a flat plateau (measured 1-2 %
-# with the decaying overshoot of the collapse); psi = 0 a load that wanders about its limit as
-# shear bands re-form (measured about 10 %; less with a slower push, docs/footing.md).
-SPREAD = {True: 0.04, False: 0.20}
+# Largest (max q - min q)/q_u over the last 30 % of the push: associated flow gives a flat plateau
+# (measured 1.3 %, the tail of the collapse's overshoot); psi = 0 a load that wanders about its
+# limit as shear bands re-form (measured 15.8 %, 8.8 % with a 3x slower push, docs/footing.md).
+# A blow-up (hourglass mode, instability) grows without bound; these fluctuations do not.
+SPREAD = {True: 0.04, False: 0.25}
 
 
 def check(name, ok, text):
@@ -75,11 +77,11 @@ def main() -> int:
             runs[psi] = r
             good &= stable(r, SPREAD[psi == phi])
         err = runs[phi].q_u / fs.COHESION / nc - 1
-        good &= check("associated q_u", abs(err) <= 0.07, f"(q_u/c - N_c)/N_c = {100 * err:+.2f} % (limit 7 %)")
-        ratio = runs[0.0].q_u / fs.COHESION / nc
-        good &= check("non-associated q_u", 0.7 <= ratio and runs[0.0].q_u < runs[phi].q_u,
-                      f"q_u/(c N_c) = {ratio:.3f}, associated {runs[phi].q_u / fs.COHESION / nc:.3f} "
-                      "(expected between 0.7 and the associated value)")
+        good &= check("associated q_u", abs(err) <= 0.06, f"(q_u/c - N_c)/N_c = {100 * err:+.2f} % (limit 6 %)")
+        davis = fs.davis_nc(phi, 0.0)
+        q0, q1 = runs[0.0].q_u / fs.COHESION, runs[phi].q_u / fs.COHESION
+        good &= check("non-associated q_u", davis <= q0 < q1,
+                      f"q_u/c = {q0:.3f}, expected between Davis's {davis:.3f} and the associated {q1:.3f}")
     else:
         ccx = os.path.join(a.ccx_prefix, "bin", "ccx_bulkflow")
         if not os.access(ccx, os.X_OK):
