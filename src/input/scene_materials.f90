@@ -116,6 +116,7 @@ contains
       if (mat%option_block(opt_user_field) /= 0) then
          m%nfieldv = mat%user_fields
          m%user_field = .true.
+         if (allocated(mat%field_props)) m%field_props = mat%field_props
          ! As in Abaqus: with a user file, *USER DEFINED FIELD calls the user's VUSDFLD.
          if (user_subroutine) then
             if (.not. associated(user_vusdfld)) then
@@ -243,17 +244,24 @@ contains
     type(material_t), intent(inout) :: m
     type(error_t), intent(inout) :: err
     real(dp), allocatable :: p(:)
-    integer :: n_ang, n_coh, n_ff, k
+    integer :: n_ang, n_coh, n_ff, k, coh_columns
     real(dp) :: apex
+    logical :: on_field
 
     n_ang = 0
     if (allocated(mat%angle_table)) n_ang = size(mat%angle_table, 2)
     n_coh = 0
-    if (allocated(mat%cohesion)) n_coh = size(mat%cohesion, 2)
+    coh_columns = 2
+    if (allocated(mat%cohesion)) then
+       n_coh = size(mat%cohesion, 2)
+       coh_columns = size(mat%cohesion, 1)
+    end if
     if (n_coh == 1) n_coh = 0          ! one row: a constant cohesion (prop 5)
+    ! rows (c, PEEQ, field 1): *MOHR COULOMB HARDENING, DEPENDENCIES=1 (prop 15 negative)
+    on_field = n_coh > 0 .and. coh_columns == 3
     n_ff = 0
     if (allocated(mat%flow_table)) n_ff = size(mat%flow_table, 2)
-    allocate (p(mc_n_scalar_props + 3 * n_ang + 2 * n_coh + 2 * n_ff))
+    allocate (p(mc_n_scalar_props + 3 * n_ang + coh_columns * n_coh + 2 * n_ff))
     p = 0
     p(1) = mat%young
     p(2) = mat%poisson
@@ -270,21 +278,22 @@ contains
     p(11) = mat%t_freeze
     p(12) = merge(1, 0, mat%record_maximum)
     p(13) = n_ang
-    p(14) = merge(1, 0, n_ang > 0)
-    p(15) = n_coh
+    p(14) = merge(1, 0, n_ang > 0 .or. on_field)
+    p(15) = merge(-n_coh, n_coh, on_field)
     p(16) = n_ff
     k = mc_n_scalar_props
     if (n_ang > 0) p(k + 1:k + 3 * n_ang) = reshape(mat%angle_table, [3 * n_ang])
     k = k + 3 * n_ang
-    if (n_coh > 0) p(k + 1:k + 2 * n_coh) = reshape(mat%cohesion, [2 * n_coh])
-    k = k + 2 * n_coh
+    if (n_coh > 0) p(k + 1:k + coh_columns * n_coh) = reshape(mat%cohesion, [coh_columns * n_coh])
+    k = k + coh_columns * n_coh
     if (n_ff > 0) p(k + 1:k + 2 * n_ff) = reshape(mat%flow_table, [2 * n_ff])
     m%vumat_name = 'MC-' // trim(mat%name)
     call move_alloc(p, m%props)
     m%nstatev = max(m%nstatev, n_state_plastic)
-    if (n_ang > 0) then
-       ! the angle table runs on field 1, which our VUSDFLD sets to the volumetric strain
-       m%nfieldv = 1
+    if (n_ang > 0 .or. on_field) then
+       ! the tables run on field 1, which our VUSDFLD sets: the volumetric strain, or with
+       ! *USER DEFINED FIELD, PROPERTIES=3 (1, t_freeze, record) the consolidation stress
+       m%nfieldv = max(m%nfieldv, 1)
        m%user_field = .true.
     end if
     ! A cut-off above the apex of the cone c*cot(phi) would never be reached; only the
