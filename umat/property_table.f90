@@ -159,7 +159,8 @@ contains
 
     block_end = first
     do while (block_end < n)
-      if (.not. (f_tab(block_end + 1) == f_tab(first))) exit
+      ! (> or <: a different field value; written so because -Wcompare-reals flags ==)
+      if (f_tab(block_end + 1) > f_tab(first) .or. f_tab(block_end + 1) < f_tab(first)) exit
       block_end = block_end + 1
     end do
   end function block_end
