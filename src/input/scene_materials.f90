@@ -21,7 +21,7 @@ module scene_materials
        opt_elastic, opt_mohr_coulomb, opt_mc_hardening, opt_tension_cutoff, opt_drucker_prager, &
        opt_dp_hardening, opt_user_material, opt_depvar, opt_user_field, opt_flow_function, &
        dp_hardening_shear, dp_hardening_tension
-  use scene_util, only: rtoa, where_text, expect_lines, check_name
+  use scene_util, only: rtoa, itoa, where_text, expect_lines, check_name
   use user_library, only: user_vusdfld, user_library_name
   implicit none
   private
@@ -139,8 +139,43 @@ contains
          m%props = [mat%young, mat%poisson]
          call final_check(mblk, m, err)
       end if
+      if (.not. err%raised .and. allocated(m%field_props) .and. .not. m%user_field_code) &
+           call check_our_field_props(deck%blocks(mat%option_block(opt_user_field)), m, err)
     end associate
   end subroutine translate
+
+  !> *USER DEFINED FIELD, PROPERTIES= for our VUSDFLD (umat/README.md): three constants, mode 0
+  !> (volumetric strain) or 1 (flow function), t_freeze, record 0 or 1; the flow-function mode
+  !> keeps sigma1 in the last state variable, which must not be one of our VUMAT's own.
+  subroutine check_our_field_props(blk, m, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(material_t), intent(in) :: m
+    type(error_t), intent(inout) :: err
+    integer :: own
+
+    associate (fp => m%field_props)
+      if (size(fp) /= 3) then
+         call blk%fail('our VUSDFLD takes PROPERTIES=3 (mode, freeze time, record); got PROPERTIES=' // &
+              itoa(size(fp)) // '; expected 3 constants or none', err)
+      else if (.not. (is_flag(fp(1)) .and. is_flag(fp(3)))) then
+         call blk%fail('our VUSDFLD''s properties ' // rtoa(fp(1)) // ', ' // rtoa(fp(2)) // ', ' // &
+              rtoa(fp(3)) // '; expected mode 0 (volumetric strain) or 1 (flow function), a freeze ' // &
+              'time, record 0 (current) or 1 (maximum)', err)
+      else if (fp(1) > 0) then
+         own = 0
+         if (model_from_name(m%vumat_name) /= model_elastic) own = n_state_plastic
+         if (m%nstatev <= own) call blk%fail('the flow-function VUSDFLD keeps sigma1 in the last state ' // &
+              'variable, but material ' // trim(m%name) // ' has ' // itoa(m%nstatev) // ', all its ' // &
+              'VUMAT''s; expected *DEPVAR >= ' // itoa(own + 1), err)
+      end if
+    end associate
+  end subroutine check_our_field_props
+
+  !> 0 or 1 exactly.
+  pure logical function is_flag(x)
+    real(dp), intent(in) :: x
+    is_flag = abs(x) <= 0 .or. abs(x - 1) <= 0
+  end function is_flag
 
   !> Which options may stand together.
   subroutine check_combinations(deck, mat, err)
