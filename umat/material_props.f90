@@ -9,7 +9,7 @@ module material_props
   use material_state, only: n_state_plastic
   use flow_function, only: flow_function_none, flow_function_linear, flow_function_bilinear, &
        flow_function_table
-  use property_table, only: table_is_ascending
+  use property_table, only: table_is_ascending, field_table_is_ordered
   use drucker_prager_match, only: match_plane_strain
   use elasticity, only: lame_constants
   implicit none
@@ -38,6 +38,8 @@ module material_props
      real(dp) :: t_freeze = 0
      logical :: record_maximum = .false.
      integer :: n_ang = 0, ang_field = 0, n_coh = 0, n_ff = 0
+     !> Cohesion table rows (c, PEEQ, field) instead of (c, PEEQ): prop 15 < 0.
+     logical :: coh_on_field = .false.
      integer :: ang_start = 0, coh_start = 0, ff_start = 0   !< index of the first table value
   end type mohr_coulomb_props_t
 
@@ -136,14 +138,18 @@ contains
     mc%ang_field = nint(props(14))
     mc%n_coh = nint(props(15))
     mc%n_ff = nint(props(16))
+    ! A negative cohesion row count selects rows (c, PEEQ, field) on the field of prop 14 (Abaqus
+    ! *MOHR COULOMB HARDENING, DEPENDENCIES=1); a positive one rows (c, PEEQ).
+    mc%coh_on_field = mc%n_coh < 0
+    mc%n_coh = abs(mc%n_coh)
 
-    if (mc%n_ang < 0 .or. mc%n_coh < 0 .or. mc%n_ff < 0) then
-       message = 'Mohr-Coulomb table row counts (props 13, 15, 16) must not be negative'
+    if (mc%n_ang < 0 .or. mc%n_ff < 0) then
+       message = 'Mohr-Coulomb table row counts (props 13, 16) must not be negative'
        return
     end if
     mc%ang_start = mc_n_scalar_props + 1
     mc%coh_start = mc%ang_start + 3 * mc%n_ang
-    mc%ff_start = mc%coh_start + 2 * mc%n_coh
+    mc%ff_start = mc%coh_start + merge(3, 2, mc%coh_on_field) * mc%n_coh
     needed = mc%ff_start + 2 * mc%n_ff - 1
     if (nprops /= needed) then
        write (message, '(a,i0,a,i0)') 'Mohr-Coulomb with these table sizes (props 13, 15, 16) takes exactly ', &
@@ -151,16 +157,18 @@ contains
        return
     end if
 
+    if (mc%n_ang > 0 .or. mc%coh_on_field) then
+       if (mc%ang_field < 1 .or. mc%ang_field > nfieldv) then
+          write (message, '(a,i0,a,i0,a)') 'angle or cohesion table uses field variable ', mc%ang_field, &
+               ' but the material has ', nfieldv, ' field variables (needs *USER DEFINED FIELD)'
+          return
+       end if
+    end if
     if (mc%n_ang == 0) then
        call check_angles(props(3), props(4), ok, message)
        if (.not. ok) return
        ok = .false.
     else
-       if (mc%ang_field < 1 .or. mc%ang_field > nfieldv) then
-          write (message, '(a,i0,a,i0,a)') 'angle table uses field variable ', mc%ang_field, &
-               ' but the material has ', nfieldv, ' field variables (needs *USER DEFINED FIELD)'
-          return
-       end if
        call check_angle_table(props(mc%ang_start:mc%coh_start - 1), mc%n_ang, ok, message)
        if (.not. ok) return
        ok = .false.
@@ -170,7 +178,18 @@ contains
        message = 'cohesion (prop 5) must not be negative'
        return
     end if
-    if (mc%n_coh > 0) then
+    if (mc%n_coh > 0 .and. mc%coh_on_field) then
+       if (.not. field_table_is_ordered(props(mc%coh_start + 1:mc%ff_start - 1:3), &
+            props(mc%coh_start + 2:mc%ff_start - 1:3))) then
+          message = 'cohesion table on a field: field values must be ascending block by block and ' // &
+               'PEEQ ascending within each block of equal field value'
+          return
+       end if
+       if (minval(props(mc%coh_start:mc%ff_start - 1:3)) < 0) then
+          message = 'cohesion table: cohesion must not be negative'
+          return
+       end if
+    else if (mc%n_coh > 0) then
        if (.not. table_is_ascending(props(mc%coh_start + 1:mc%ff_start - 1:2))) then
           message = 'cohesion table: PEEQ values must be ascending'
           return

@@ -19,7 +19,7 @@ module material_update
        rebuild_plane_block, principal_3d_block, rebuild_3d_block
   use mohr_coulomb_return, only: mohr_coulomb_return_block
   use drucker_prager_return, only: drucker_prager_stress_return
-  use property_table, only: interpolate_table
+  use property_table, only: interpolate_table, interpolate_table_field
   use flow_function, only: flow_function_none, unconfined_yield_strength, &
        cohesion_from_unconfined_strength
   implicit none
@@ -130,6 +130,10 @@ contains
                      state_old(k, sdv_sigma1_consolidation), props(mc%ff_start:ff_end:2), &
                      props(mc%ff_start + 1:ff_end:2))
                 cohesion(i) = cohesion_from_unconfined_strength(fc, sin_phi(i))
+             else if (mc%coh_on_field) then
+                cohesion(i) = interpolate_table_field(props(mc%coh_start + 1:coh_end:3), &
+                     props(mc%coh_start + 2:coh_end:3), props(mc%coh_start:coh_end:3), &
+                     state_old(k, sdv_peeq), field_new(k, mc%ang_field))
              else if (mc%n_coh > 0) then
                 cohesion(i) = interpolate_table(props(mc%coh_start + 1:coh_end:2), &
                      props(mc%coh_start:coh_end:2), state_old(k, sdv_peeq))

@@ -35,7 +35,8 @@ module scene_material_options
      real(dp) :: young = 0, poisson = 0
      real(dp) :: phi = 0, psi = 0                 !< *MOHR COULOMB without DEPENDENCIES
      real(dp), allocatable :: angle_table(:, :)   !< (3, n): phi, psi, field 1 (DEPENDENCIES=1)
-     real(dp), allocatable :: cohesion(:, :)      !< (2, n): c, plastic strain
+     !> (2, n): c, plastic strain; (3, n) with DEPENDENCIES=1: c, plastic strain, field 1
+     real(dp), allocatable :: cohesion(:, :)
      real(dp) :: sigma_t = 0
      real(dp) :: beta = 0, k_ratio = 1, psi_dp = 0
      integer :: dp_hardening_type = dp_hardening_compression
@@ -45,6 +46,7 @@ module scene_material_options
      !> Output names from *DEPVAR lines "SDV number, name[, description]" ('' where none given)
      character(len=name_length), allocatable :: sdv_names(:)
      integer :: user_fields = 1                   !< *USER DEFINED FIELD, FIELDS=n (VUSDFLD's nfieldv)
+     real(dp), allocatable :: field_props(:)      !< *USER DEFINED FIELD, PROPERTIES=n constants
      integer :: flow_kind = 0                     !< umat flow_function kinds: 1 linear, 2 bilinear, 3 table
      real(dp) :: fc0 = 0, slope = 0, t_freeze = 0
      logical :: record_maximum = .false.
@@ -106,10 +108,7 @@ contains
     case (opt_user_field)
        ! FIELDS=n as bulkflow-matpoint takes it: the nfieldv a VUSDFLD writes (a user's VUSDFLD
        ! may write more than field 1; the host's arrays must have that many columns).
-       call blk%check_params([character(len=8) :: 'FIELDS'], err)
-       if (.not. err%raised) call blk%get_integer('FIELDS', mat%user_fields, err, default=1, minimum=1, &
-            maximum=64)
-       if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines (the fields are set by VUSDFLD)', err)
+       call read_user_field(blk, mat, err)
     case default
        call read_flow_function(blk, mat, err)
     end select
@@ -238,35 +237,66 @@ contains
     mat%psi = mat%angle_table(2, 1)
   end subroutine read_mohr_coulomb
 
+  !> *MOHR COULOMB HARDENING [, DEPENDENCIES=1]: rows c, plastic strain [, temperature (ignored,
+  !> may be blank), field 1]. With the field, rows come in blocks of equal field value (ascending),
+  !> the plastic strain ascending from 0 inside each block (Abaqus's data order).
   subroutine read_mc_hardening(blk, mat, err)
     type(keyword_block_t), intent(in) :: blk
     type(material_input_t), intent(inout) :: mat
     type(error_t), intent(inout) :: err
-    integer :: il
+    character(len=:), allocatable :: expected
+    integer :: il, ndep, ncol
+    real(dp) :: temperature
+    logical :: new_block
 
-    call blk%check_params([character(len=8) ::], err)
+    call blk%check_params([character(len=12) :: 'DEPENDENCIES'], err)
     if (err%raised) return
-    call expect_lines(blk, 1, huge(1), 'rows cohesion, plastic strain', err)
+    call blk%get_integer('DEPENDENCIES', ndep, err, default=0, minimum=0)
     if (err%raised) return
-    allocate (mat%cohesion(2, blk%n_lines))
+    if (ndep > 1) then
+       call blk%fail('*MOHR COULOMB HARDENING: DEPENDENCIES=' // itoa(ndep) // ' is not supported; ' // &
+            'expected DEPENDENCIES=1 (cohesion against plastic strain and field 1)', err)
+       return
+    end if
+    ncol = 2 + ndep
+    expected = 'cohesion, plastic strain (no temperature dependence)'
+    if (ndep == 1) expected = 'cohesion, plastic strain, temperature (ignored, may be blank), field 1'
+    call expect_lines(blk, 1, huge(1), 'rows ' // expected, err)
+    if (err%raised) return
+    allocate (mat%cohesion(ncol, blk%n_lines))
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
-         call expect_fields(blk, dl, 1, 2, 'cohesion, plastic strain (no temperature dependence)', err)
+         call expect_fields(blk, dl, 1 + 3 * ndep, 2 + 2 * ndep, expected, err)
          if (err%raised) return
          call get_real(dl, 1, mat%cohesion(1, il), err)
          if (.not. err%raised) call get_real(dl, 2, mat%cohesion(2, il), err, default=0.0_dp)
+         if (ndep == 1) then
+            if (.not. err%raised) call get_real(dl, 3, temperature, err, default=0.0_dp)
+            if (.not. err%raised) call get_real(dl, 4, mat%cohesion(3, il), err)
+         end if
          if (err%raised) return
          if (mat%cohesion(1, il) < 0) then
             call raise_error(dl%file, dl%line, 'cohesion ' // rtoa(mat%cohesion(1, il)) // &
                  ' is negative; expected c >= 0', err)
             return
          end if
-         if (il == 1 .and. abs(mat%cohesion(2, il)) > 0) then
-            call raise_error(dl%file, dl%line, 'first plastic strain is ' // rtoa(mat%cohesion(2, il)) // &
-                 '; expected the first row at plastic strain 0', err)
+         new_block = il == 1
+         if (ndep == 1 .and. il > 1) then
+            if (mat%cohesion(3, il) < mat%cohesion(3, il - 1)) then
+               call raise_error(dl%file, dl%line, 'field value ' // rtoa(mat%cohesion(3, il)) // &
+                    ' is below the previous row''s; expected field 1 ascending (rows of one field ' // &
+                    'value together, plastic strain varying fastest)', err)
+               return
+            end if
+            new_block = mat%cohesion(3, il) > mat%cohesion(3, il - 1)
+         end if
+         if (new_block .and. abs(mat%cohesion(2, il)) > 0) then
+            call raise_error(dl%file, dl%line, 'first plastic strain' // &
+                 trim(merge(' of this field value', '                    ', ndep == 1)) // ' is ' // &
+                 rtoa(mat%cohesion(2, il)) // '; expected the first row at plastic strain 0', err)
             return
          end if
-         if (il > 1) then
+         if (.not. new_block) then
             if (.not. (mat%cohesion(2, il) > mat%cohesion(2, il - 1))) then
                call raise_error(dl%file, dl%line, 'plastic strain ' // rtoa(mat%cohesion(2, il)) // &
                     ' does not increase; expected plastic strain strictly ascending', err)
@@ -370,7 +400,7 @@ contains
     type(material_input_t), intent(inout) :: mat
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: utype
-    integer :: n, il, k, m
+    integer :: n
 
     call blk%check_params([character(len=9) :: 'CONSTANTS', 'TYPE'], err)
     if (err%raised) return
@@ -378,26 +408,60 @@ contains
     if (err%raised) return
     call blk%get_integer('CONSTANTS', n, err, minimum=0, maximum=100000)
     if (err%raised) return
-    allocate (mat%user_props(n))
+    call read_constants(blk, n, 'CONSTANTS', mat%user_props, err)
+  end subroutine read_user_material
+
+  !> Exactly n real constants, any number per data line (*USER MATERIAL, *USER DEFINED FIELD).
+  subroutine read_constants(blk, n, count_name, values, err)
+    type(keyword_block_t), intent(in) :: blk
+    integer, intent(in) :: n
+    character(len=*), intent(in) :: count_name
+    real(dp), allocatable, intent(out) :: values(:)
+    type(error_t), intent(inout) :: err
+    integer :: il, k, m
+
+    allocate (values(n))
     m = 0
     do il = 1, blk%n_lines
        associate (dl => blk%lines(il))
          do k = 1, dl%n_fields()
             if (field_blank(dl, k) .and. k == dl%n_fields()) exit
             if (m >= n) then
-               call raise_error(dl%file, dl%line, 'data beyond what *USER MATERIAL takes: more than ' // &
-                    'CONSTANTS=' // itoa(n) // ' values; expected ' // itoa(n) // ' constants', err)
+               call raise_error(dl%file, dl%line, 'data beyond what ' // keyword_text(blk) // ' takes: more than ' // &
+                    count_name // '=' // itoa(n) // ' values; expected ' // itoa(n) // ' constants', err)
                return
             end if
             m = m + 1
-            call get_real(dl, k, mat%user_props(m), err)
+            call get_real(dl, k, values(m), err)
             if (err%raised) return
          end do
        end associate
     end do
-    if (m < n) call blk%fail('*USER MATERIAL: ' // itoa(m) // ' constants given; expected CONSTANTS=' // &
-         itoa(n), err)
-  end subroutine read_user_material
+    if (m < n) call blk%fail(keyword_text(blk) // ': ' // itoa(m) // ' constants given; expected ' // &
+         count_name // '=' // itoa(n), err)
+  end subroutine read_constants
+
+  !> *USER DEFINED FIELD [, FIELDS=n] [, PROPERTIES=m]: FIELDS as bulkflow-matpoint takes it, the
+  !> nfieldv a VUSDFLD writes (a user's VUSDFLD may write more than field 1); PROPERTIES, as in
+  !> Abaqus/Explicit, the constants handed to VUSDFLD as props (m values on the data lines).
+  subroutine read_user_field(blk, mat, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(material_input_t), intent(inout) :: mat
+    type(error_t), intent(inout) :: err
+    integer :: n
+
+    call blk%check_params([character(len=10) :: 'FIELDS', 'PROPERTIES'], err)
+    if (err%raised) return
+    call blk%get_integer('FIELDS', mat%user_fields, err, default=1, minimum=1, maximum=64)
+    if (err%raised) return
+    call blk%get_integer('PROPERTIES', n, err, default=0, minimum=0, maximum=100000)
+    if (err%raised) return
+    if (n == 0) then
+       call expect_lines(blk, 0, 0, 'no data lines without PROPERTIES= (the fields are set by VUSDFLD)', err)
+       return
+    end if
+    call read_constants(blk, n, 'PROPERTIES', mat%field_props, err)
+  end subroutine read_user_field
 
   !> *DEPVAR: "n" on the first line; Abaqus's optional further lines "SDV number, output name[,
   !> description]" name the state variables in the material-point driver's CSV.

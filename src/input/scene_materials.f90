@@ -21,7 +21,7 @@ module scene_materials
        opt_elastic, opt_mohr_coulomb, opt_mc_hardening, opt_tension_cutoff, opt_drucker_prager, &
        opt_dp_hardening, opt_user_material, opt_depvar, opt_user_field, opt_flow_function, &
        dp_hardening_shear, dp_hardening_tension
-  use scene_util, only: rtoa, where_text, expect_lines, check_name
+  use scene_util, only: rtoa, itoa, where_text, expect_lines, check_name
   use user_library, only: user_vumat, user_vusdfld, user_library_name
   implicit none
   private
@@ -144,6 +144,7 @@ contains
       if (mat%option_block(opt_user_field) /= 0) then
          m%nfieldv = mat%user_fields
          m%user_field = .true.
+         if (allocated(mat%field_props)) m%field_props = mat%field_props
          ! As in Abaqus: with a user file, *USER DEFINED FIELD calls the user's VUSDFLD.
          if (user_subroutine) then
             if (.not. associated(user_vusdfld)) then
@@ -166,8 +167,43 @@ contains
          m%props = [mat%young, mat%poisson]
          call final_check(mblk, m, err)
       end if
+      if (.not. err%raised .and. allocated(m%field_props) .and. .not. m%user_field_code) &
+           call check_our_field_props(deck%blocks(mat%option_block(opt_user_field)), m, err)
     end associate
   end subroutine translate
+
+  !> *USER DEFINED FIELD, PROPERTIES= for our VUSDFLD (umat/README.md): three constants, mode 0
+  !> (volumetric strain) or 1 (flow function), t_freeze, record 0 or 1; the flow-function mode
+  !> keeps sigma1 in the last state variable, which must not be one of our VUMAT's own.
+  subroutine check_our_field_props(blk, m, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(material_t), intent(in) :: m
+    type(error_t), intent(inout) :: err
+    integer :: own
+
+    associate (fp => m%field_props)
+      if (size(fp) /= 3) then
+         call blk%fail('our VUSDFLD takes PROPERTIES=3 (mode, freeze time, record); got PROPERTIES=' // &
+              itoa(size(fp)) // '; expected 3 constants or none', err)
+      else if (.not. (is_flag(fp(1)) .and. is_flag(fp(3)))) then
+         call blk%fail('our VUSDFLD''s properties ' // rtoa(fp(1)) // ', ' // rtoa(fp(2)) // ', ' // &
+              rtoa(fp(3)) // '; expected mode 0 (volumetric strain) or 1 (flow function), a freeze ' // &
+              'time, record 0 (current) or 1 (maximum)', err)
+      else if (fp(1) > 0) then
+         own = 0
+         if (model_from_name(m%vumat_name) /= model_elastic) own = n_state_plastic
+         if (m%nstatev <= own) call blk%fail('the flow-function VUSDFLD keeps sigma1 in the last state ' // &
+              'variable, but material ' // trim(m%name) // ' has ' // itoa(m%nstatev) // ', all its ' // &
+              'VUMAT''s; expected *DEPVAR >= ' // itoa(own + 1), err)
+      end if
+    end associate
+  end subroutine check_our_field_props
+
+  !> 0 or 1 exactly.
+  pure logical function is_flag(x)
+    real(dp), intent(in) :: x
+    is_flag = abs(x) <= 0 .or. abs(x - 1) <= 0
+  end function is_flag
 
   !> Which options may stand together.
   subroutine check_combinations(deck, mat, err)
@@ -279,17 +315,24 @@ contains
     type(material_t), intent(inout) :: m
     type(error_t), intent(inout) :: err
     real(dp), allocatable :: p(:)
-    integer :: n_ang, n_coh, n_ff, k
+    integer :: n_ang, n_coh, n_ff, k, coh_columns
     real(dp) :: apex
+    logical :: on_field
 
     n_ang = 0
     if (allocated(mat%angle_table)) n_ang = size(mat%angle_table, 2)
     n_coh = 0
-    if (allocated(mat%cohesion)) n_coh = size(mat%cohesion, 2)
+    coh_columns = 2
+    if (allocated(mat%cohesion)) then
+       n_coh = size(mat%cohesion, 2)
+       coh_columns = size(mat%cohesion, 1)
+    end if
     if (n_coh == 1) n_coh = 0          ! one row: a constant cohesion (prop 5)
+    ! rows (c, PEEQ, field 1): *MOHR COULOMB HARDENING, DEPENDENCIES=1 (prop 15 negative)
+    on_field = n_coh > 0 .and. coh_columns == 3
     n_ff = 0
     if (allocated(mat%flow_table)) n_ff = size(mat%flow_table, 2)
-    allocate (p(mc_n_scalar_props + 3 * n_ang + 2 * n_coh + 2 * n_ff))
+    allocate (p(mc_n_scalar_props + 3 * n_ang + coh_columns * n_coh + 2 * n_ff))
     p = 0
     p(1) = mat%young
     p(2) = mat%poisson
@@ -306,22 +349,22 @@ contains
     p(11) = mat%t_freeze
     p(12) = merge(1, 0, mat%record_maximum)
     p(13) = n_ang
-    p(14) = merge(1, 0, n_ang > 0)
-    p(15) = n_coh
+    p(14) = merge(1, 0, n_ang > 0 .or. on_field)
+    p(15) = merge(-n_coh, n_coh, on_field)
     p(16) = n_ff
     k = mc_n_scalar_props
     if (n_ang > 0) p(k + 1:k + 3 * n_ang) = reshape(mat%angle_table, [3 * n_ang])
     k = k + 3 * n_ang
-    if (n_coh > 0) p(k + 1:k + 2 * n_coh) = reshape(mat%cohesion, [2 * n_coh])
-    k = k + 2 * n_coh
+    if (n_coh > 0) p(k + 1:k + coh_columns * n_coh) = reshape(mat%cohesion, [coh_columns * n_coh])
+    k = k + coh_columns * n_coh
     if (n_ff > 0) p(k + 1:k + 2 * n_ff) = reshape(mat%flow_table, [2 * n_ff])
     m%vumat_name = 'MC-' // trim(mat%name)
     call move_alloc(p, m%props)
     m%nstatev = max(m%nstatev, n_state_plastic)
-    if (n_ang > 0) then
-       ! the angle table runs on field 1, which our VUSDFLD sets to the volumetric strain (a
-       ! user's VUSDFLD may write more: *USER DEFINED FIELD, FIELDS=n)
-       m%nfieldv = max(1, m%nfieldv)
+    if (n_ang > 0 .or. on_field) then
+       ! the tables run on field 1, which our VUSDFLD sets: the volumetric strain, or with
+       ! *USER DEFINED FIELD, PROPERTIES=3 (1, t_freeze, record) the consolidation stress
+       m%nfieldv = max(m%nfieldv, 1)
        m%user_field = .true.
     end if
     ! A cut-off above the apex of the cone c*cot(phi) would never be reached; only the

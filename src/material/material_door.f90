@@ -131,9 +131,16 @@ contains
        call host_set_block_extra(state(1:nb, 1:ns), w%temp(1:nb), peeq=state(1:nb, 1))
        call host_set_block_moduli(lambda, shear)
        w%field_new(1:nb, 1:nfieldv) = field(1:nb, 1:nfieldv)
-       call usdfld(nb, nstatev, nfieldv, nprops, 3, nshr, elem_number, 1, 1, 1, step_time, total_time, &
-            dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), char_length, &
-            mat%props, state(1:nb, 1:ns), w%state_mid(1:nb, 1:ns), w%field_new(1:nb, 1:nfieldv))
+       if (allocated(mat%field_props)) then
+          call usdfld(nb, nstatev, nfieldv, size(mat%field_props), 3, nshr, elem_number, 1, 1, 1, step_time, &
+               total_time, dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), &
+               char_length, mat%field_props, state(1:nb, 1:ns), w%state_mid(1:nb, 1:ns), &
+               w%field_new(1:nb, 1:nfieldv))
+       else
+          call usdfld(nb, nstatev, nfieldv, nprops, 3, nshr, elem_number, 1, 1, 1, step_time, total_time, &
+               dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), char_length, &
+               mat%props, state(1:nb, 1:ns), w%state_mid(1:nb, 1:ns), w%field_new(1:nb, 1:nfieldv))
+       end if
        call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
             mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
             w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, w%state_mid(1:nb, 1:ns), &
@@ -203,10 +210,17 @@ contains
           call host_set_block(n, ncomp, stress(i0:i1, :), log_strain(i0:i1, :))
           call host_set_block_extra(state(i0:i1, 1:ns), w%temp(i0:i1))
           call host_set_block_moduli(lambda, shear)
-          call usdfld(n, nstatev, nfieldv, nprops, 3, nshr, elem_number(i0:i1), 1, 1, 1, step_time, &
-               total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), w%direct(1:n, :, :), &
-               char_length(i0:i1), mat%props, state(i0:i1, 1:ns), w%state_mid(1:n, 1:ns), &
-               w%field_new(1:n, 1:nfieldv))
+          if (allocated(mat%field_props)) then
+             call usdfld(n, nstatev, nfieldv, size(mat%field_props), 3, nshr, elem_number(i0:i1), 1, 1, 1, &
+                  step_time, total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), &
+                  w%direct(1:n, :, :), char_length(i0:i1), mat%field_props, state(i0:i1, 1:ns), &
+                  w%state_mid(1:n, 1:ns), w%field_new(1:n, 1:nfieldv))
+          else
+             call usdfld(n, nstatev, nfieldv, nprops, 3, nshr, elem_number(i0:i1), 1, 1, 1, step_time, &
+                  total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), w%direct(1:n, :, :), &
+                  char_length(i0:i1), mat%props, state(i0:i1, 1:ns), w%state_mid(1:n, 1:ns), &
+                  w%field_new(1:n, 1:nfieldv))
+          end if
        end if
        w%state_new(1:n, 1:ns) = w%state_mid(1:n, 1:ns)
        call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &

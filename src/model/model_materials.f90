@@ -18,6 +18,9 @@ module model_materials
      character(len=name_length), allocatable :: sdv_names(:)
      integer :: nfieldv = 0                      !< 1 with *USER DEFINED FIELD (field 1), else 0
      logical :: user_field = .false.             !< call vusdfld before vumat
+     !> *USER DEFINED FIELD, PROPERTIES=n constants: the vusdfld's props (Abaqus). Without them
+     !> the vusdfld receives the material's props (bulkflow's convention before PROPERTIES=).
+     real(dp), allocatable :: field_props(:)
      logical :: user_material = .false.          !< props come from *USER MATERIAL
      !> The --user library's vumat (a *USER MATERIAL with a user file loaded), not ours.
      logical :: user_code = .false.
