@@ -1,0 +1,325 @@
+!> The solver's side of the VUMAT/VUSDFLD door for element and particle blocks (both techniques
+!> call materials through here; it sits below them, docs/architecture.md).
+!>
+!> vumat and vusdfld are called through implicit interfaces, exactly as Abaqus calls user code;
+!> material_entry says whose (ours, or the --user library's for a *USER MATERIAL). The first
+!> argument of vumat is jblock = [nblock, npt, layer, kspt, noel(1:nblock)] so both the
+!> scalar-nblock and the "jblock" styles of VUMAT work (docs/user_subroutines.md). Times passed
+!> are those at the end of the increment; the packaging call has stepTime = totalTime = 0.
+!> A user's VUMAT gets at most n_vec_length = 136 points per call, coordMp and the temperatures
+!> from the work set (the caller fills them), and stressNew, stateNew and the energies holding
+!> the old values on entry (call_user_material).
+!> With a user field, vusdfld runs first on the same block with the start-of-increment stress
+!> and logarithmic strain available to vgetvrm; its fields become the vumat's fieldNew and its
+!> state the vumat's stateOld.
+module material_vumat_call
+  use material_kinds, only: dp
+  use error_report, only: raise_error
+  use abaqus_host, only: host_set_block, host_set_block_extra
+  use model_materials, only: material_t
+  use material_entry, only: vumat_entry, vusdfld_entry
+  implicit none
+  private
+
+  !> The most points one call hands a user's VUMAT (Abaqus's n_vec_Length, vaba_param.inc).
+  integer, parameter, public :: n_vec_length = 136
+
+  !> Arguments of a vumat call that the solver does not keep between increments.
+  type, public :: vumat_work_t
+     character(len=8) :: point_kind = 'element'       !< what elem_number counts (messages)
+     integer, allocatable :: jblock(:)
+     real(dp), allocatable :: coord(:, :), temp(:), temp_new(:), stretch_old(:, :), stretch_new(:, :)
+     real(dp), allocatable :: defgrad_old(:, :), defgrad_new(:, :), field_new(:, :)
+     real(dp), allocatable :: stress_new(:, :), state_mid(:, :), state_new(:, :)
+     real(dp), allocatable :: e_int_new(:), e_inel_new(:), density(:), direct(:, :, :)
+  end type vumat_work_t
+
+  public :: vumat_work_init, call_material, packaging_modulus, checked_packaging_modulus
+
+contains
+
+  subroutine vumat_work_init(w, nmax, ncomp, nshr, nstatev, nfieldv)
+    type(vumat_work_t), intent(inout) :: w
+    integer, intent(in) :: nmax, ncomp, nshr, nstatev, nfieldv
+    integer :: k
+
+    if (allocated(w%jblock)) deallocate(w%jblock, w%coord, w%temp, w%temp_new, w%stretch_old, w%stretch_new, &
+         w%defgrad_old, w%defgrad_new, w%field_new, w%stress_new, w%state_mid, w%state_new, &
+         w%e_int_new, w%e_inel_new, w%density, w%direct)
+    allocate(w%jblock(4 + nmax), w%coord(nmax, 3), w%temp(nmax), w%temp_new(nmax))
+    allocate(w%stretch_old(nmax, ncomp), w%stretch_new(nmax, ncomp))
+    allocate(w%defgrad_old(nmax, ncomp + nshr), w%defgrad_new(nmax, ncomp + nshr))
+    allocate(w%field_new(nmax, max(1, nfieldv)), w%stress_new(nmax, ncomp))
+    allocate(w%state_mid(nmax, max(1, nstatev)), w%state_new(nmax, max(1, nstatev)))
+    allocate(w%e_int_new(nmax), w%e_inel_new(nmax), w%density(nmax), w%direct(nmax, 3, 3))
+    w%jblock = 1
+    w%coord = 0
+    w%temp = 0
+    w%temp_new = 0
+    w%direct = 0
+    do k = 1, 3
+       w%direct(:, k, k) = 1
+    end do
+  end subroutine vumat_work_init
+
+  !> One increment of the material of a block: [vusdfld] then vumat. Arrays are the block's
+  !> (nb, ...) arrays; on return stress/state/field/energies hold the new values.
+  subroutine call_material(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, &
+       char_length, density, strain_inc, rel_spin, stretch_old, stretch_new, defgrad_old, &
+       defgrad_new, log_strain, stress, state, field, e_int, e_inel, w)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: nb, ncomp, nshr
+    integer, intent(in) :: elem_number(nb)
+    real(dp), intent(in) :: step_time, total_time, dt
+    real(dp), intent(in) :: char_length(nb), density(nb), strain_inc(nb, ncomp), rel_spin(nb, nshr)
+    real(dp), intent(in) :: stretch_old(nb, ncomp), stretch_new(nb, ncomp)
+    real(dp), intent(in) :: defgrad_old(nb, ncomp + nshr), defgrad_new(nb, ncomp + nshr)
+    real(dp), intent(in) :: log_strain(:, :)
+    ! stress and state are the block's own arrays: allocatable, so the new values can be
+    ! swapped in from the work arrays instead of copied (the copies were most of the memmove
+    ! of a run).
+    real(dp), allocatable, intent(inout) :: stress(:, :), state(:, :)
+    real(dp), intent(inout) :: field(:, :)
+    ! Allocatable for the same reason as stress and state.
+    real(dp), allocatable, intent(inout) :: e_int(:), e_inel(:)
+    type(vumat_work_t), intent(inout) :: w
+    integer :: nstatev, nfieldv, nprops, ns, nf
+    procedure(), pointer :: umat, usdfld
+
+    if (mat%user_code) then
+       call call_user_material(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, char_length, &
+            density, strain_inc, rel_spin, stretch_old, stretch_new, defgrad_old, defgrad_new, log_strain, &
+            stress, state, field, e_int, e_inel, w)
+       return
+    end if
+    umat => vumat_entry(.false.)
+    usdfld => vusdfld_entry(mat%user_field_code)
+    nstatev = mat%nstatev
+    nfieldv = mat%nfieldv
+    nprops = size(mat%props)
+    ! The block's state and field arrays have this material's columns (at least one); the work
+    ! arrays have the largest count of all materials. Every copy and every argument uses the
+    ! block's count: whole-column assignments between the two failed (debug) or overran the
+    ! block's arrays (release) as soon as two materials had different *DEPVAR counts. The
+    ! sections (1:nb, 1:ns) are contiguous (the work arrays have exactly nb rows).
+    ns = size(state, 2)
+    nf = size(field, 2)
+    w%jblock(1:4) = [nb, 1, 1, 1]
+    w%jblock(5:4 + nb) = elem_number
+    if (mat%user_field) then
+       call host_set_block(nb, ncomp, stress, log_strain(1:nb, :))
+       call host_set_block_extra(state(1:nb, 1:ns), w%temp(1:nb), peeq=state(1:nb, 1))
+       w%field_new(1:nb, 1:nfieldv) = field(1:nb, 1:nfieldv)
+       call usdfld(nb, nstatev, nfieldv, nprops, 3, nshr, elem_number, 1, 1, 1, step_time, total_time, &
+            dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), char_length, &
+            mat%props, state(1:nb, 1:ns), w%state_mid(1:nb, 1:ns), w%field_new(1:nb, 1:nfieldv))
+       call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
+            mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
+            w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, w%state_mid(1:nb, 1:ns), &
+            e_int, e_inel, w%temp_new(1:nb), stretch_new, defgrad_new, w%field_new(1:nb, 1:nf), &
+            w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
+    else
+       ! Without a user field stateOld is the block's state itself (a contiguous (nb, ns) array,
+       ! read only by the VUMAT): no copy through state_mid. The fields do not change, so the
+       ! block's array is fieldOld and fieldNew at once (both read-only for a VUMAT); before, it
+       ! was copied to the work array and back every call.
+       call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
+            mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
+            w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, state(1:nb, 1:ns), &
+            e_int, e_inel, w%temp_new(1:nb), stretch_new, defgrad_new, field(1:nb, 1:nf), &
+            w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
+    end if
+    ! The new stress and state become the block's by swapping allocations when the shapes agree
+    ! (work sets have exactly nb rows; state columns agree unless materials differ in *DEPVAR
+    ! counts); the old arrays become the work arrays the next VUMAT call overwrites.
+    call swap_or_copy(stress, w%stress_new, nb, ncomp)
+    call swap_or_copy(state, w%state_new, nb, ns)
+    if (mat%user_field) field(1:nb, 1:nf) = w%field_new(1:nb, 1:nf)
+    call swap_or_copy_1d(e_int, w%e_int_new, nb)
+    call swap_or_copy_1d(e_inel, w%e_inel_new, nb)
+  end subroutine call_material
+
+  !> call_material for a *USER MATERIAL with a user's file loaded: the block in pieces of at most
+  !> n_vec_length points (array sections: copied in and out by the compiler where they are not
+  !> contiguous), stressNew, stateNew, fieldNew and the energies holding the old values on entry
+  !> (a VUMAT that leaves an output alone keeps the old value, as in Abaqus).
+  subroutine call_user_material(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, &
+       char_length, density, strain_inc, rel_spin, stretch_old, stretch_new, defgrad_old, &
+       defgrad_new, log_strain, stress, state, field, e_int, e_inel, w)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: nb, ncomp, nshr
+    integer, intent(in) :: elem_number(nb)
+    real(dp), intent(in) :: step_time, total_time, dt
+    real(dp), intent(in) :: char_length(nb), density(nb), strain_inc(nb, ncomp), rel_spin(nb, nshr)
+    real(dp), intent(in) :: stretch_old(nb, ncomp), stretch_new(nb, ncomp)
+    real(dp), intent(in) :: defgrad_old(nb, ncomp + nshr), defgrad_new(nb, ncomp + nshr)
+    real(dp), intent(in) :: log_strain(:, :)
+    real(dp), intent(inout) :: stress(:, :), state(:, :), field(:, :), e_int(:), e_inel(:)
+    type(vumat_work_t), intent(inout) :: w
+    procedure(), pointer :: umat, usdfld
+    integer :: nstatev, nfieldv, nprops, ns, nf, i0, i1, n
+
+    umat => vumat_entry(.true.)
+    usdfld => vusdfld_entry(mat%user_field_code)
+    nstatev = mat%nstatev
+    nfieldv = mat%nfieldv
+    nprops = size(mat%props)
+    ns = size(state, 2)
+    nf = size(field, 2)
+    do i0 = 1, nb, n_vec_length
+       i1 = min(nb, i0 + n_vec_length - 1)
+       n = i1 - i0 + 1
+       w%jblock(1:4) = [n, 1, 1, 1]
+       w%jblock(5:4 + n) = elem_number(i0:i1)
+       w%stress_new(1:n, :) = stress(i0:i1, :)
+       w%state_mid(1:n, 1:ns) = state(i0:i1, 1:ns)
+       w%field_new(1:n, 1:nf) = field(i0:i1, 1:nf)
+       w%e_int_new(1:n) = e_int(i0:i1)
+       w%e_inel_new(1:n) = e_inel(i0:i1)
+       if (mat%user_field) then
+          call host_set_block(n, ncomp, stress(i0:i1, :), log_strain(i0:i1, :))
+          call host_set_block_extra(state(i0:i1, 1:ns), w%temp(i0:i1))
+          call usdfld(n, nstatev, nfieldv, nprops, 3, nshr, elem_number(i0:i1), 1, 1, 1, step_time, &
+               total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), w%direct(1:n, :, :), &
+               char_length(i0:i1), mat%props, state(i0:i1, 1:ns), w%state_mid(1:n, 1:ns), &
+               w%field_new(1:n, 1:nfieldv))
+       end if
+       w%state_new(1:n, 1:ns) = w%state_mid(1:n, 1:ns)
+       call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
+            mat%vumat_name, w%coord(i0:i1, :), char_length(i0:i1), mat%props, density(i0:i1), &
+            strain_inc(i0:i1, :), rel_spin(i0:i1, :), w%temp(i0:i1), stretch_old(i0:i1, :), &
+            defgrad_old(i0:i1, :), field(i0:i1, 1:nf), stress(i0:i1, :), w%state_mid(1:n, 1:ns), &
+            e_int(i0:i1), e_inel(i0:i1), w%temp_new(i0:i1), stretch_new(i0:i1, :), defgrad_new(i0:i1, :), &
+            w%field_new(1:n, 1:nf), w%stress_new(1:n, :), w%state_new(1:n, 1:ns), w%e_int_new(1:n), &
+            w%e_inel_new(1:n))
+       call check_finite(mat, n, ncomp, elem_number(i0:i1), total_time, w%stress_new, w%point_kind)
+       stress(i0:i1, :) = w%stress_new(1:n, :)
+       state(i0:i1, 1:ns) = w%state_new(1:n, 1:ns)
+       field(i0:i1, 1:nf) = w%field_new(1:n, 1:nf)
+       e_int(i0:i1) = w%e_int_new(1:n)
+       e_inel(i0:i1) = w%e_inel_new(1:n)
+    end do
+  end subroutine call_user_material
+
+  !> Stop with the material, the element or particle and the time when a user's VUMAT returned
+  !> a stress that is not a finite number (it would spread through the mesh as NaN).
+  subroutine check_finite(mat, n, ncomp, numbers, total_time, stress_new, point_kind)
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: n, ncomp, numbers(n)
+    real(dp), intent(in) :: total_time, stress_new(:, :)
+    character(len=*), intent(in) :: point_kind
+    character(len=160) :: text
+    integer :: k, j
+
+    do j = 1, ncomp
+       do k = 1, n
+          if (ieee_is_finite(stress_new(k, j))) cycle
+          write (text, '(a,i0,a,i0,a,es13.6)') trim(point_kind) // ' ', numbers(k), ': stress component ', j, &
+               ' is not a finite number at total time ', total_time
+          call raise_error(trim(mat%source), 0, 'the user VUMAT of material ' // trim(mat%name) // &
+               ' returned a stress that is not a number: ' // trim(text) // '; expected finite stressNew')
+       end do
+    end do
+  end subroutine check_finite
+
+  !> swap_or_copy for the (nb) energy arrays.
+  subroutine swap_or_copy_1d(block, work, nb)
+    real(dp), allocatable, intent(inout) :: block(:), work(:)
+    integer, intent(in) :: nb
+    real(dp), allocatable :: held(:)
+
+    if (size(block) == nb .and. size(work) == nb) then
+       call move_alloc(block, held)
+       call move_alloc(work, block)
+       call move_alloc(held, work)
+    else
+       block(1:nb) = work(1:nb)
+    end if
+  end subroutine swap_or_copy_1d
+
+  !> block(1:nb, 1:nc) ← work(1:nb, 1:nc): by exchanging the allocations when both have exactly
+  !> that shape, else by copying.
+  subroutine swap_or_copy(block, work, nb, nc)
+    real(dp), allocatable, intent(inout) :: block(:, :), work(:, :)
+    integer, intent(in) :: nb, nc
+    real(dp), allocatable :: held(:, :)
+
+    if (size(block, 1) == nb .and. size(block, 2) == nc .and. size(work, 1) == nb &
+         .and. size(work, 2) == nc) then
+       call move_alloc(block, held)
+       call move_alloc(work, block)
+       call move_alloc(held, work)
+    else
+       block(1:nb, 1:nc) = work(1:nb, 1:nc)
+    end if
+  end subroutine swap_or_copy
+
+  !> packaging_modulus, stopping with the material's name (where it is defined) when the VUMAT's
+  !> answer is no stiffness: zero, negative, NaN or infinite (a stable increment from it would be
+  !> meaningless; Abaqus makes this check on its own packaging call).
+  function checked_packaging_modulus(mat, ncomp, nshr, file) result(modulus)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: ncomp, nshr
+    character(len=*), intent(in) :: file
+    real(dp) :: modulus
+    character(len=32) :: text
+
+    modulus = packaging_modulus(mat, ncomp, nshr)
+    if (modulus > 0 .and. modulus <= huge(1.0_dp)) return
+    write (text, '(es12.4)') modulus
+    call raise_error(file, 0, 'material ' // trim(mat%name) // ' (defined at ' // trim(mat%source) // &
+         '): its VUMAT answered the packaging call (a strain increment 1e-6 in direction 11 at ' // &
+         'stepTime = totalTime = 0) with the stiffness ' // trim(adjustl(text)) // '; expected a positive, ' // &
+         'finite elastic modulus (stress from strainInc or defgradNew; see docs/user_subroutines.md)')
+  end function checked_packaging_modulus
+
+  !> Abaqus's packaging call: a tiny uniaxial strain increment from a stress-free state at
+  !> stepTime = totalTime = 0; Δσ11/Δε11 is the P-wave modulus λ + 2G that sets the wave
+  !> speed for the stable increment, hourglass and bulk viscosity.
+  function packaging_modulus(mat, ncomp, nshr) result(modulus)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: ncomp, nshr
+    real(dp) :: modulus
+    real(dp), parameter :: probe = 1.0e-6_dp
+    real(dp) :: strain(1, ncomp), spin(1, nshr), stretch(1, ncomp), defgrad(1, ncomp + nshr)
+    real(dp) :: stretch_new(1, ncomp), defgrad_new(1, ncomp + nshr)
+    real(dp) :: stress_old(1, ncomp), stress_new(1, ncomp), state_old(1, max(1, mat%nstatev))
+    real(dp) :: state_new(1, max(1, mat%nstatev)), field(1, max(1, mat%nfieldv))
+    real(dp) :: coord(1, 3), scalar1(1), e_old(1), e_new(1), ei_new(1), density(1)
+    integer :: jblock(5)
+    procedure(), pointer :: umat
+
+    umat => vumat_entry(mat%user_code)
+    strain = 0
+    strain(1, 1) = probe
+    spin = 0
+    stretch = 0
+    stretch(1, 1:3) = 1
+    defgrad = 0
+    defgrad(1, 1:3) = 1
+    ! The end state agrees with the strain increment: a VUMAT that forms its stress from
+    ! defgradNew or stretchNew (hyperelastic) sees the same probe as one that integrates strainInc.
+    stretch_new = stretch
+    stretch_new(1, 1) = 1 + probe
+    defgrad_new = defgrad
+    defgrad_new(1, 1) = 1 + probe
+    stress_old = 0
+    stress_new = 0
+    state_old = 0
+    field = 0
+    coord = 0
+    scalar1 = 0
+    e_old = 0
+    density = mat%density
+    jblock = [1, 1, 1, 1, 1]
+    state_new = 0
+    e_new = 0
+    ei_new = 0
+    call umat(jblock, 3, nshr, mat%nstatev, mat%nfieldv, size(mat%props), 0, 0.0_dp, 0.0_dp, 1.0_dp, &
+         mat%vumat_name, coord, [1.0_dp], mat%props, density, strain, spin, scalar1, stretch, defgrad, &
+         field, stress_old, state_old, e_old, e_old, scalar1, stretch_new, defgrad_new, field, stress_new, &
+         state_new, e_new, ei_new)
+    modulus = stress_new(1, 1) / probe
+  end function packaging_modulus
+end module material_vumat_call
