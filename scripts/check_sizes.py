@@ -18,6 +18,10 @@ import re
 import sys
 from pathlib import Path
 
+# The same files as the layer check: every Fortran source under src/ and umat/.
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from check_layers import source_files  # noqa: E402
+
 MAX_FILE_LINES = 700
 MAX_ROUTINE_LINES = 150
 
@@ -40,7 +44,6 @@ ROUTINE_EXCEPTIONS: dict[tuple[str, str], str] = {
         'TEMPORARY (i18-mpm): every routine of mpm_run.f90 until its split on branch i18-mpm',
 }
 
-SUFFIXES = ('.f90', '.inc', '.f90.in')
 START_RE = re.compile(
     r'^\s*(?:(?:pure|elemental|impure|recursive|module|non_recursive)\s+)*'
     r'(?:(?:integer|logical|real|complex|character|double\s+precision|type\s*\([^)]*\)|class\s*\([^)]*\))'
@@ -48,15 +51,6 @@ START_RE = re.compile(
     r'(?:(?:pure|elemental|impure|recursive|module)\s+)*'
     r'(subroutine|function)\s+(\w+)', re.IGNORECASE)
 END_RE = re.compile(r'^\s*end\s*(subroutine|function)\b|^\s*end\s*$', re.IGNORECASE)
-
-
-def source_files(root: Path) -> list[Path]:
-    files = []
-    for top in ('src', 'umat'):
-        base = root / top
-        if base.is_dir():
-            files += [p for p in base.rglob('*') if p.is_file() and p.name.endswith(SUFFIXES)]
-    return sorted(files)
 
 
 def routines(lines: list[str]):
@@ -67,8 +61,6 @@ def routines(lines: list[str]):
         if not text.strip():
             continue
         if END_RE.match(text) and stack:
-            if re.match(r'^\s*end\s*$', text, re.IGNORECASE) and not stack:
-                continue
             name, first = stack.pop()
             yield name, first, number - first + 1
             continue
