@@ -4,7 +4,7 @@
 module output_hdf5_basics
   use, intrinsic :: iso_c_binding, only: c_loc, c_char, c_ptr
   use hdf5
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: raise_error
   implicit none
   private

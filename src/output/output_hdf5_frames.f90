@@ -4,7 +4,7 @@
 !> frame list from what the file holds. The layout: docs/output_format.md.
 module output_hdf5_frames
   use hdf5
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use output_files, only: int_to_str
   use output_xdmf, only: xdmf_frame_t, xdmf_add_attribute, xdmf_center_node, xdmf_center_cell
   use output_hdf5_basics, only: check, dataset_space, read_attr_real, read_attr_string

@@ -5,7 +5,7 @@ module output_hdf5_rows
   use, intrinsic :: iso_c_binding, only: c_loc
   use mpi_f08, only: MPI_Comm, MPI_Alltoall, MPI_Alltoallv, MPI_INTEGER, MPI_DOUBLE_PRECISION
   use hdf5
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: raise_error
   use output_files, only: int_to_str
   use output_hdf5_basics, only: check, dataset_rows, block_spaces
