@@ -40,8 +40,6 @@ ROUTINE_EXCEPTIONS: dict[tuple[str, str], str] = {
     ('umat/principal_stress.f90', 'principal_3d_block'):
         'fused, vectorised 3D eigen-decomposition of a chunk (scaling, invariants, roots, vectors '
         'in one branch-free pass per step; a call per step would spill the chunk arrays)',
-    ('src/mpm/mpm_run.f90', '*'):
-        'TEMPORARY (i18-mpm): every routine of mpm_run.f90 until its split on branch i18-mpm',
 }
 
 START_RE = re.compile(
