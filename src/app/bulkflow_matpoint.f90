@@ -11,18 +11,19 @@ program bulkflow_matpoint
   use, intrinsic :: iso_fortran_env, only: output_unit
   use material_kinds, only: dp
   use error_report, only: report_and_stop
-  use matpoint_material, only: matpoint_material_t
+  use model_materials, only: material_t
   use matpoint_path, only: matpoint_path_t, test_names, test_triaxial, test_biaxial, &
        test_oedometer, test_simple_shear, simple_shear_component
   use matpoint_input, only: read_matpoint_file
   use matpoint_solver, only: matpoint_history_t, run_material_point
   use matpoint_csv, only: write_matpoint_csv, mean_pressure, von_mises
-  use user_library, only: user_library_prepare, user_library_open, user_vusdfld
+  use user_library, only: user_library_prepare, user_library_open
+  use material_entry, only: use_linked_entries
   implicit none
 
   character(len=:), allocatable :: input, output, title, user_file
   character(len=1024), allocatable :: user_includes(:)
-  type(matpoint_material_t) :: mat
+  type(material_t) :: mat
   type(matpoint_path_t) :: path
   type(matpoint_history_t) :: history
   logical :: help
@@ -30,10 +31,9 @@ program bulkflow_matpoint
   call parse_arguments(input, output, help)
   if (.not. help) then
      if (len(user_file) > 0) call load_user_file()
+     ! bulkflow-matpoint-user (a user's file compiled in): *USER MATERIALs are the user's.
+     if (user_linked() .and. len(user_file) == 0) call use_linked_entries()
      call read_matpoint_file(input, mat, path, title=title)
-     if (len(user_file) > 0 .and. mat%user_field .and. .not. associated(user_vusdfld)) &
-          call report_and_stop(input, 0, '*USER DEFINED FIELD but the user file ' // user_file // &
-          ' defines no VUSDFLD; expected SUBROUTINE VUSDFLD in it')
      call run_material_point(mat, path, history)
      call write_matpoint_csv(output, mat, path, history)
      call print_summary()
@@ -115,6 +115,13 @@ contains
     if (status /= 0) call report_and_stop('', 0, message)
   end subroutine load_user_file
 
+  !> True in bulkflow-matpoint-user, whose user file is linked in (matpoint_user_linked.f90).
+  logical function user_linked()
+    external :: bulkflow_matpoint_user_linked
+
+    call bulkflow_matpoint_user_linked(user_linked)
+  end function user_linked
+
   subroutine usage(message)
     character(len=*), intent(in) :: message
 
@@ -140,8 +147,9 @@ contains
     end do
     yes_no = merge('yes', 'no ', mat%user_field)
     if (len_trim(title) > 0) write (output_unit, '(a)') 'bulkflow-matpoint: ' // title
-    write (output_unit, '(a,i0,a,i0,a)') '  material  ' // mat%name // ' (', size(mat%props), &
-         ' constants, ', mat%nstatev, ' SDVs, user field: ' // trim(yes_no) // ')'
+    write (output_unit, '(a,i0,a,i0,a)') '  material  ' // trim(mat%name) // ' (VUMAT ' // &
+         trim(mat%vumat_name) // ', ', size(mat%props), ' constants, ', mat%nstatev, &
+         ' SDVs, user field: ' // trim(yes_no) // ')'
     write (output_unit, '(a,i0,a,i0,a,i0,a,i0,a)') '  test      ' // trim(test_names(path%test)) // &
          ', ', merge(3, 2, path%ndim == 3), 'D, axis ', path%axis, ', ', path%n_stages, &
          ' stage(s), ', last - 1, ' increments'

@@ -13,7 +13,7 @@ module driver_elements
   use driver_solver, only: solver_t, element_block_t
   use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
        effect_bulk_viscosity, effect_user_field, effect_assembly
-  use material_vumat_call, only: vumat_work_t, call_material, vumat_work_init
+  use material_door, only: vumat_work_t, call_material, vumat_work_init
   use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_internal_force_bv, &
        cpe4r_hourglass_update
   use fem_c3d8r, only: c3d8r_kinematics, c3d8r_internal_force, c3d8r_hourglass

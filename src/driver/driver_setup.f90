@@ -9,7 +9,7 @@ module driver_setup
   use parallel_assembly, only: assemble_element_vectors, block_assembly_t, block_assembly_init, &
        assembly_start, assembly_add_block, assembly_finish
   use driver_solver, only: solver_t, element_block_t, build_blocks
-  use material_vumat_call, only: checked_packaging_modulus
+  use material_door, only: checked_packaging_modulus
   use fem_cpe4r, only: cpe4r_geometry, cpe4r_internal_force
   use fem_c3d8r, only: c3d8r_geometry, c3d8r_internal_force
   use fem_corotation, only: identity_rotation, stored_to_global

@@ -42,6 +42,8 @@ module scene_material_options
      real(dp) :: dp_yield = 0
      real(dp), allocatable :: user_props(:)
      integer :: depvar = 0
+     !> Output names from *DEPVAR lines "SDV number, name[, description]" ('' where none given)
+     character(len=name_length), allocatable :: sdv_names(:)
      integer :: user_fields = 1                   !< *USER DEFINED FIELD, FIELDS=n (VUSDFLD's nfieldv)
      integer :: flow_kind = 0                     !< umat flow_function kinds: 1 linear, 2 bilinear, 3 table
      real(dp) :: fc0 = 0, slope = 0, t_freeze = 0
@@ -397,19 +399,43 @@ contains
          itoa(n), err)
   end subroutine read_user_material
 
+  !> *DEPVAR: "n" on the first line; Abaqus's optional further lines "SDV number, output name[,
+  !> description]" name the state variables in the material-point driver's CSV.
   subroutine read_depvar(blk, mat, err)
     type(keyword_block_t), intent(in) :: blk
     type(material_input_t), intent(inout) :: mat
     type(error_t), intent(inout) :: err
+    integer :: il, k
 
     call blk%check_params([character(len=8) ::], err)
     if (err%raised) return
-    call one_line(blk, 1, 1, 'the number of state variables', err)
+    call expect_lines(blk, 1, huge(1), 'the number of state variables, then optional lines ' // &
+         '"SDV number, name[, description]"', err)
+    if (err%raised) return
+    call expect_fields(blk, blk%lines(1), 1, 1, 'the number of state variables (element deletion, ' // &
+         'the second field, is not supported)', err)
     if (err%raised) return
     call get_int(blk%lines(1), 1, mat%depvar, err)
     if (err%raised) return
-    if (mat%depvar < 0 .or. mat%depvar > 10000) call raise_error(blk%lines(1)%file, blk%lines(1)%line, &
-         'number of state variables ' // itoa(mat%depvar) // ' is out of range; expected 0..10000', err)
+    if (mat%depvar < 0 .or. mat%depvar > 10000) then
+       call raise_error(blk%lines(1)%file, blk%lines(1)%line, &
+            'number of state variables ' // itoa(mat%depvar) // ' is out of range; expected 0..10000', err)
+       return
+    end if
+    allocate (mat%sdv_names(mat%depvar))
+    mat%sdv_names = ''
+    do il = 2, blk%n_lines
+       associate (dl => blk%lines(il))
+         call get_int(dl, 1, k, err)
+         if (err%raised) return
+         if (k < 1 .or. k > mat%depvar .or. dl%n_fields() < 2) then
+            call raise_error(dl%file, dl%line, 'state variable ' // itoa(k) // ' named; expected ' // &
+                 '"SDV number (1..' // itoa(mat%depvar) // '), name[, description]"', err)
+            return
+         end if
+         mat%sdv_names(k) = dl%field(2)
+       end associate
+    end do
   end subroutine read_depvar
 
   !> bulkflow's *FLOW FUNCTION, TYPE=LINEAR|BILINEAR|TABLE [, FREEZE TIME=t] [, RECORD=...]

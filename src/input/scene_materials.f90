@@ -16,7 +16,7 @@ module scene_materials
        decode_drucker_prager, mohr_coulomb_props_t, drucker_prager_props_t, message_length, &
        mc_n_scalar_props
   use material_state, only: n_state_plastic
-  use scene_layout, only: scene_layout_t
+  use scene_layout, only: scene_layout_t, is_material_option
   use scene_material_options, only: material_input_t, read_material_option, opt_density, &
        opt_elastic, opt_mohr_coulomb, opt_mc_hardening, opt_tension_cutoff, opt_drucker_prager, &
        opt_dp_hardening, opt_user_material, opt_depvar, opt_user_field, opt_flow_function, &
@@ -26,7 +26,7 @@ module scene_materials
   implicit none
   private
 
-  public :: build_materials, find_material
+  public :: build_materials, build_deck_materials, find_material
 
 contains
 
@@ -92,6 +92,33 @@ contains
     end do
   end subroutine build_materials
 
+  !> The materials of a deck that is not a scene (the material-point driver's input, whose
+  !> other keywords scan_layout does not know): the options of a *MATERIAL are the material
+  !> options that follow it directly, as in a scene. An option that follows no *MATERIAL is
+  !> left to the caller (its keyword loop sees it first).
+  subroutine build_deck_materials(deck, model, user_subroutine, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(model_t), intent(inout) :: model
+    logical, intent(in) :: user_subroutine
+    type(error_t), intent(inout) :: err
+    type(scene_layout_t) :: layout
+    integer :: i, chain
+
+    allocate (layout%owner(deck%n_blocks))
+    layout%owner = 0
+    chain = 0
+    do i = 1, deck%n_blocks
+       if (deck%blocks(i)%name == 'MATERIAL') then
+          chain = i
+       else if (is_material_option(deck%blocks(i)%name)) then
+          layout%owner(i) = chain
+       else
+          chain = 0
+       end if
+    end do
+    call build_materials(deck, layout, model, user_subroutine, err)
+  end subroutine build_deck_materials
+
   subroutine translate(deck, mat, user_subroutine, m, err)
     type(keyword_deck_t), intent(in) :: deck
     type(material_input_t), intent(in) :: mat
@@ -113,6 +140,7 @@ contains
       end if
       m%density = mat%density
       m%nstatev = mat%depvar
+      if (allocated(mat%sdv_names)) m%sdv_names = mat%sdv_names
       if (mat%option_block(opt_user_field) /= 0) then
          m%nfieldv = mat%user_fields
          m%user_field = .true.

@@ -20,7 +20,9 @@
 module matpoint_csv
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use matpoint_material, only: matpoint_material_t, sdv_label
+  use model_materials, only: material_t
+  use material_props, only: model_from_name, model_mohr_coulomb, model_drucker_prager
+  use material_state, only: state_names
   use matpoint_path, only: matpoint_path_t, component_label, test_triaxial, test_biaxial, &
        test_oedometer, test_simple_shear, simple_shear_component
   use matpoint_solver, only: matpoint_history_t
@@ -52,7 +54,7 @@ contains
 
   !> The header line (comma-separated column names).
   function csv_header(mat, path, h) result(line)
-    type(matpoint_material_t), intent(in) :: mat
+    type(material_t), intent(in) :: mat
     type(matpoint_path_t), intent(in) :: path
     type(matpoint_history_t), intent(in) :: h
     character(len=:), allocatable :: line
@@ -88,7 +90,7 @@ contains
   !> Write the history to `filename`.
   subroutine write_matpoint_csv(filename, mat, path, h, err)
     character(len=*), intent(in) :: filename
-    type(matpoint_material_t), intent(in) :: mat
+    type(material_t), intent(in) :: mat
     type(matpoint_path_t), intent(in) :: path
     type(matpoint_history_t), intent(in) :: h
     type(error_t), intent(inout), optional :: err
@@ -141,5 +143,32 @@ contains
     end do
     write (unit, '(a)') line
   end subroutine write_row
+
+  !> Column label of state variable `i`: the name given on a *DEPVAR line, else for our MC and
+  !> DP models their names (umat/README.md, "State variables"), else SDV<i>.
+  function sdv_label(mat, i) result(label)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: i
+    character(len=:), allocatable :: label
+    character(len=16) :: buf
+
+    if (allocated(mat%sdv_names)) then
+       if (i <= size(mat%sdv_names)) then
+          if (len_trim(mat%sdv_names(i)) > 0) then
+             label = trim(mat%sdv_names(i))
+             return
+          end if
+       end if
+    end if
+    select case (model_from_name(mat%vumat_name))
+    case (model_mohr_coulomb, model_drucker_prager)
+       if (i <= size(state_names)) then
+          label = trim(state_names(i))
+          return
+       end if
+    end select
+    write (buf, '(a,i0)') 'SDV', i
+    label = trim(buf)
+  end function sdv_label
 
 end module matpoint_csv

@@ -1,9 +1,10 @@
-!> Small dense linear solve for the mixed-control Newton step (n <= 6).
-!> Gaussian elimination with partial pivoting; a pivot below `rel_tol` times the largest
-!> entry marks the matrix singular, so the caller can fall back to the elastic stiffness
-!> instead of producing Inf/NaN.
+!> Small dense linear solve for the mixed-control Newton step (n <= 6), by LAPACK's dgesv
+!> (LU with partial pivoting). A pivot of U below `rel_tol` times the largest entry of the
+!> matrix marks it singular (dgesv itself only reports an exact zero), so the caller can fall
+!> back to the elastic stiffness instead of producing Inf/NaN.
 module matpoint_dense_solve
   use material_kinds, only: dp
+  use lapack_interfaces, only: dgesv
   implicit none
   private
 
@@ -11,41 +12,31 @@ module matpoint_dense_solve
 
 contains
 
-  pure subroutine solve_dense(n, a_in, b, x, singular, rel_tol)
+  subroutine solve_dense(n, a_in, b, x, singular, rel_tol)
     integer, intent(in) :: n
     real(dp), intent(in) :: a_in(n, n), b(n)
     real(dp), intent(out) :: x(n)
     logical, intent(out) :: singular
     real(dp), intent(in) :: rel_tol
-    real(dp) :: a(n, n), r(n), amax, f, row(n), rk
-    integer :: k, i, p
+    real(dp) :: lu(n, n), rhs(n, 1), amax
+    integer :: pivots(n), info, k
 
-    a = a_in
-    r = b
     x = 0.0_dp
     singular = .true.
     if (n == 0) then
        singular = .false.
        return
     end if
-    amax = maxval(abs(a))
+    amax = maxval(abs(a_in))
     if (.not. (amax > 0.0_dp) .or. amax > huge(1.0_dp)) return
+    lu = a_in
+    rhs(:, 1) = b
+    call dgesv(n, 1, lu, n, pivots, rhs, n, info)
+    if (info /= 0) return
     do k = 1, n
-       p = k - 1 + maxloc(abs(a(k:n, k)), dim=1)
-       if (.not. (abs(a(p, k)) > rel_tol * amax)) return
-       if (p /= k) then
-          row = a(k, :); a(k, :) = a(p, :); a(p, :) = row
-          rk = r(k); r(k) = r(p); r(p) = rk
-       end if
-       do i = k + 1, n
-          f = a(i, k) / a(k, k)
-          a(i, k:n) = a(i, k:n) - f * a(k, k:n)
-          r(i) = r(i) - f * r(k)
-       end do
+       if (.not. (abs(lu(k, k)) > rel_tol * amax)) return
     end do
-    do k = n, 1, -1
-       x(k) = (r(k) - dot_product(a(k, k + 1:n), x(k + 1:n))) / a(k, k)
-    end do
+    x = rhs(:, 1)
     singular = .false.
   end subroutine solve_dense
 

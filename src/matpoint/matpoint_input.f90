@@ -1,16 +1,19 @@
 !> Builds the material and the loading path of a material-point run from keyword blocks
-!> (keyword_reader). Every mistake stops at its file:line. Keywords (inputs/matpoint/README.md
-!> has the full description):
+!> (keyword_reader). Every mistake stops at its file:line. The material is read by the scene
+!> reader's material part (scene_materials: the same keywords, checks and translation into our
+!> VUMATs as in a scene); this module reads the path. Keywords (inputs/matpoint/README.md has
+!> the full description):
 !>
 !>   *HEADING                        title (data lines), optional
-!>   *MATERIAL, NAME=name            the material; the name selects our model (umat/README.md)
-!>   *DENSITY                        data: ρ
-!>   *USER MATERIAL, CONSTANTS=n     data: the n props, any count per line
-!>   *DEPVAR                         data: nstatev; optional lines "i, NAME[, description]"
-!>   *USER DEFINED FIELD [, FIELDS=n]   call vusdfld before each vumat (n fields, default 1)
+!>   *MATERIAL, NAME=name            exactly one, with its options right after it, as in a scene:
+!>     *DENSITY, *ELASTIC, *MOHR COULOMB [, DEPENDENCIES=1], *MOHR COULOMB HARDENING,
+!>     *TENSION CUTOFF, *FLOW FUNCTION, *DRUCKER PRAGER, *DRUCKER PRAGER HARDENING,
+!>     *USER MATERIAL, CONSTANTS=n, *DEPVAR (optional lines "i, NAME[, description"),
+!>     *USER DEFINED FIELD [, FIELDS=n]          (docs/keywords.md)
 !>   *INITIAL CONDITIONS, TYPE=STRESS    data: s11, s22, s33, s12[, s23, s31] (VUMAT order)
 !>   *INITIAL CONDITIONS, TYPE=SOLUTION  data: SDV1, SDV2, ...
 !>   *INITIAL CONDITIONS, TYPE=FIELD, VARIABLE=i   data: value of field i
+!>   *INITIAL CONDITIONS, TYPE=TEMPERATURE         data: the temperature (tempOld = tempNew)
 !>   *TEST, TYPE=t [, DIMENSION=2|3] [, AXIS=1|2|3]
 !>   *STAGE, INC=n [, TIME=t] [, STRAIN=x] [, STRESS=s]   (GENERAL: data "comp, STRAIN|STRESS|HOLD, value")
 !>   *DRIVER CONTROLS [, TOLERANCE=tol] [, ITERATIONS=n]
@@ -19,7 +22,11 @@ module matpoint_input
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, read_keyword_file, &
        read_keyword_string, upper_case
-  use matpoint_material, only: matpoint_material_t
+  use model, only: model_t
+  use model_materials, only: material_t
+  use scene_layout, only: is_material_option
+  use scene_materials, only: build_deck_materials
+  use user_library, only: user_library_loaded
   use matpoint_path, only: matpoint_path_t, matpoint_stage_t, max_components, control_strain, &
        control_stress, control_stress_hold, test_general, test_triaxial, test_biaxial, &
        test_oedometer, test_isotropic, test_names, test_from_name, default_dimension, &
@@ -29,17 +36,18 @@ module matpoint_input
 
   public :: build_matpoint_input, read_matpoint_file, read_matpoint_string
 
-  character(len=20), parameter :: known_keywords(11) = [character(len=20) :: &
-       'HEADING', 'MATERIAL', 'DENSITY', 'USER MATERIAL', 'DEPVAR', 'USER DEFINED FIELD', &
-       'INITIAL CONDITIONS', 'TEST', 'STAGE', 'DRIVER CONTROLS', 'INCLUDE']
+  character(len=24), parameter :: known_keywords(18) = [character(len=24) :: &
+       'HEADING', 'MATERIAL', 'DENSITY', 'ELASTIC', 'MOHR COULOMB', 'MOHR COULOMB HARDENING', &
+       'TENSION CUTOFF', 'FLOW FUNCTION', 'DRUCKER PRAGER', 'DRUCKER PRAGER HARDENING', &
+       'USER MATERIAL', 'DEPVAR', 'USER DEFINED FIELD', 'INITIAL CONDITIONS', 'TEST', 'STAGE', &
+       'DRIVER CONTROLS', 'INCLUDE']
 
   !> What has been seen so far (for order and completeness checks).
   type :: build_state_t
-     logical :: have_material = .false., have_density = .false., have_props = .false.
+     integer :: material_block = 0
      logical :: have_test = .false.
-     type(keyword_block_t) :: material_block, stress_block
+     type(keyword_block_t) :: stress_block
      logical :: have_stress = .false.
-     integer :: fields_declared = 0
   end type build_state_t
 
 contains
@@ -47,7 +55,7 @@ contains
   !> Read an input file and build material + path.
   subroutine read_matpoint_file(filename, mat, path, err, title)
     character(len=*), intent(in) :: filename
-    type(matpoint_material_t), intent(out) :: mat
+    type(material_t), intent(out) :: mat
     type(matpoint_path_t), intent(out) :: path
     type(error_t), intent(inout), optional :: err
     character(len=:), allocatable, intent(out), optional :: title
@@ -67,7 +75,7 @@ contains
   !> Same from keyword text in a string (tests); `name` is used in messages.
   subroutine read_matpoint_string(text, mat, path, err, name)
     character(len=*), intent(in) :: text
-    type(matpoint_material_t), intent(out) :: mat
+    type(material_t), intent(out) :: mat
     type(matpoint_path_t), intent(out) :: path
     type(error_t), intent(inout), optional :: err
     character(len=*), intent(in), optional :: name
@@ -83,47 +91,52 @@ contains
   !> Interpret the keyword blocks.
   subroutine build_matpoint_input(deck, mat, path, err, title)
     type(keyword_deck_t), intent(in) :: deck
-    type(matpoint_material_t), intent(out) :: mat
+    type(material_t), intent(out) :: mat
     type(matpoint_path_t), intent(out) :: path
     type(error_t), intent(inout), optional :: err
     character(len=:), allocatable, intent(out), optional :: title
     type(error_t) :: local
     type(build_state_t) :: st
     character(len=:), allocatable :: t
-    integer :: b
+    integer :: b, chain
 
     t = ''
-    allocate (mat%props(0))
+    chain = 0
     do b = 1, deck%n_blocks
        associate (blk => deck%blocks(b))
-         select case (blk%name)
-         case ('HEADING')
-            call read_heading(blk, t)
-         case ('MATERIAL')
-            call read_material(blk, mat, st, local)
-         case ('DENSITY')
-            call read_density(blk, mat, st, local)
-         case ('USER MATERIAL')
-            call read_user_material(blk, mat, st, local)
-         case ('DEPVAR')
-            call read_depvar(blk, mat, st, local)
-         case ('USER DEFINED FIELD')
-            call read_user_field(blk, mat, st, local)
-         case ('INITIAL CONDITIONS')
-            call read_initial_conditions(blk, path, st, local)
-         case ('TEST')
-            call read_test(blk, path, st, local)
-         case ('STAGE')
-            call read_stage(blk, path, st, local)
-         case ('DRIVER CONTROLS')
-            call read_controls(blk, path, local)
-         case default
-            call blk%fail('unknown keyword *' // blk%name // ' (the material-point driver ' // &
-                 'knows ' // keyword_list() // ')', local)
-         end select
+         if (blk%name == 'MATERIAL') then
+            if (st%material_block /= 0) then
+               call blk%fail('a material-point input has exactly one *MATERIAL', local)
+            else
+               st%material_block = b
+               chain = b
+            end if
+         else if (is_material_option(blk%name)) then
+            ! read with its *MATERIAL by the scene reader's material part (read_point_material)
+            if (chain == 0) call blk%fail('*' // blk%name // ' must follow *MATERIAL (right after ' // &
+                 'it or after another option of the material)', local)
+         else
+            chain = 0
+            select case (blk%name)
+            case ('HEADING')
+               call read_heading(blk, t)
+            case ('INITIAL CONDITIONS')
+               call read_initial_conditions(blk, path, st, local)
+            case ('TEST')
+               call read_test(blk, path, st, local)
+            case ('STAGE')
+               call read_stage(blk, path, st, local)
+            case ('DRIVER CONTROLS')
+               call read_controls(blk, path, local)
+            case default
+               call blk%fail('unknown keyword *' // blk%name // ' (the material-point driver ' // &
+                    'knows ' // keyword_list() // ')', local)
+            end select
+         end if
        end associate
        if (local%raised) exit
     end do
+    if (.not. local%raised) call read_point_material(deck, st, mat, local)
     if (.not. local%raised) call final_checks(deck, mat, path, st, local)
     if (local%raised) call raise_error('', 0, local%message, err)
     if (present(title)) title = t
@@ -171,153 +184,31 @@ contains
     end if
   end subroutine expect_lines
 
-  !> Error unless a *MATERIAL came before this material option.
-  subroutine need_material(blk, st, err)
-    type(keyword_block_t), intent(in) :: blk
+  !> The one *MATERIAL and its options, read as a scene's (scene_materials): with a user file
+  !> loaded (--user, or linked into bulkflow-matpoint-user) a *USER MATERIAL is the user's.
+  subroutine read_point_material(deck, st, mat, err)
+    type(keyword_deck_t), intent(in) :: deck
     type(build_state_t), intent(in) :: st
+    type(material_t), intent(out) :: mat
     type(error_t), intent(inout) :: err
+    type(model_t) :: materials
 
-    if (.not. st%have_material) call blk%fail('*' // blk%name // ' must follow *MATERIAL', err)
-  end subroutine need_material
-
-  subroutine read_material(blk, mat, st, err)
-    type(keyword_block_t), intent(in) :: blk
-    type(matpoint_material_t), intent(inout) :: mat
-    type(build_state_t), intent(inout) :: st
-    type(error_t), intent(inout) :: err
-    character(len=:), allocatable :: name
-
-    if (st%have_material) then
-       call blk%fail('a material-point input has exactly one *MATERIAL', err)
+    if (st%material_block == 0) then
+       call raise_error(deck_file(deck), 0, 'no *MATERIAL in the input', err)
        return
     end if
-    call blk%check_params([character(len=4) :: 'NAME'], err)
+    call build_deck_materials(deck, materials, user_library_loaded(), err)
     if (err%raised) return
-    call blk%get_string('NAME', name, err, keep_case=.true.)
-    if (err%raised) return
-    ! Abaqus passes the name upper-cased (cmname), whatever the input's spelling.
-    name = trim(upper_case(name))
-    if (len(name) > 80) then
-       call blk%fail('material name longer than 80 characters', err)
-       return
-    end if
-    call expect_lines(blk, 0, err)
-    if (err%raised) return
-    mat%name = name
-    st%have_material = .true.
-    st%material_block = blk
-  end subroutine read_material
+    mat = materials%materials(1)
+  end subroutine read_point_material
 
-  subroutine read_density(blk, mat, st, err)
-    type(keyword_block_t), intent(in) :: blk
-    type(matpoint_material_t), intent(inout) :: mat
-    type(build_state_t), intent(inout) :: st
-    type(error_t), intent(inout) :: err
+  function deck_file(deck) result(file)
+    type(keyword_deck_t), intent(in) :: deck
+    character(len=:), allocatable :: file
 
-    call need_material(blk, st, err)
-    if (err%raised) return
-    call blk%check_params([character(len=1) :: ], err)
-    if (err%raised) return
-    call expect_lines(blk, 1, err)
-    if (err%raised) return
-    if (blk%lines(1)%n_fields() /= 1) then
-       call raise_error(blk%lines(1)%file, blk%lines(1)%line, &
-            '*DENSITY takes one value (no temperature dependence)', err)
-       return
-    end if
-    call blk%lines(1)%real_field(1, mat%density, err)
-    if (err%raised) return
-    if (.not. (mat%density > 0.0_dp)) then
-       call raise_error(blk%lines(1)%file, blk%lines(1)%line, 'the density must be positive', err)
-       return
-    end if
-    st%have_density = .true.
-  end subroutine read_density
-
-  subroutine read_user_material(blk, mat, st, err)
-    type(keyword_block_t), intent(in) :: blk
-    type(matpoint_material_t), intent(inout) :: mat
-    type(build_state_t), intent(inout) :: st
-    type(error_t), intent(inout) :: err
-    integer :: n
-    character(len=:), allocatable :: kind
-    character(len=64) :: msg
-
-    call need_material(blk, st, err)
-    if (err%raised) return
-    call blk%check_params([character(len=9) :: 'CONSTANTS', 'TYPE'], err)
-    if (err%raised) return
-    call blk%get_string('TYPE', kind, err, default='MECHANICAL', &
-         choices=[character(len=10) :: 'MECHANICAL'])
-    if (err%raised) return
-    call blk%get_integer('CONSTANTS', n, err, minimum=1)
-    if (err%raised) return
-    call blk%all_reals(mat%props, err)
-    if (err%raised) return
-    if (size(mat%props) /= n) then
-       write (msg, '(a,i0,a,i0,a)') '*USER MATERIAL, CONSTANTS=', n, ' but ', size(mat%props), &
-            ' values are given'
-       call blk%fail(trim(msg), err)
-       return
-    end if
-    st%have_props = .true.
-  end subroutine read_user_material
-
-  subroutine read_depvar(blk, mat, st, err)
-    type(keyword_block_t), intent(in) :: blk
-    type(matpoint_material_t), intent(inout) :: mat
-    type(build_state_t), intent(inout) :: st
-    type(error_t), intent(inout) :: err
-    integer :: i, k
-
-    call need_material(blk, st, err)
-    if (err%raised) return
-    call blk%check_params([character(len=1) :: ], err)
-    if (err%raised) return
-    if (blk%n_lines < 1) then
-       call blk%fail('*DEPVAR needs a data line with the number of state variables', err)
-       return
-    end if
-    if (blk%lines(1)%n_fields() > 1) then
-       call raise_error(blk%lines(1)%file, blk%lines(1)%line, &
-            'element deletion (2nd field of *DEPVAR) is not supported by the material-point driver', err)
-       return
-    end if
-    call blk%lines(1)%integer_field(1, mat%nstatev, err)
-    if (err%raised) return
-    if (mat%nstatev < 0) then
-       call raise_error(blk%lines(1)%file, blk%lines(1)%line, 'negative number of state variables', err)
-       return
-    end if
-    ! Abaqus form of the following lines: SDV number, output name, description.
-    do i = 2, blk%n_lines
-       call blk%lines(i)%integer_field(1, k, err)
-       if (err%raised) return
-       if (k < 1 .or. k > mat%nstatev .or. blk%lines(i)%n_fields() < 2) then
-          call raise_error(blk%lines(i)%file, blk%lines(i)%line, &
-               'expected "SDV number (1..nstatev), name[, description]"', err)
-          return
-       end if
-       call mat%set_sdv_name(k, blk%lines(i)%field(2))
-    end do
-  end subroutine read_depvar
-
-  subroutine read_user_field(blk, mat, st, err)
-    type(keyword_block_t), intent(in) :: blk
-    type(matpoint_material_t), intent(inout) :: mat
-    type(build_state_t), intent(inout) :: st
-    type(error_t), intent(inout) :: err
-
-    call need_material(blk, st, err)
-    if (err%raised) return
-    call blk%check_params([character(len=6) :: 'FIELDS'], err)
-    if (err%raised) return
-    call blk%get_integer('FIELDS', st%fields_declared, err, default=1, minimum=1)
-    if (err%raised) return
-    call expect_lines(blk, 0, err)
-    if (err%raised) return
-    mat%user_field = .true.
-  end subroutine read_user_field
+    file = '<input>'
+    if (deck%n_blocks > 0) file = deck%blocks(1)%file
+  end function deck_file
 
   subroutine read_initial_conditions(blk, path, st, err)
     type(keyword_block_t), intent(in) :: blk
@@ -330,7 +221,8 @@ contains
 
     call blk%check_params([character(len=8) :: 'TYPE', 'VARIABLE'], err)
     if (err%raised) return
-    call blk%get_string('TYPE', kind, err, choices=[character(len=8) :: 'STRESS', 'SOLUTION', 'FIELD'])
+    call blk%get_string('TYPE', kind, err, choices=[character(len=11) :: 'STRESS', 'SOLUTION', 'FIELD', &
+         'TEMPERATURE'])
     if (err%raised) return
     if (kind /= 'FIELD' .and. blk%has_param('VARIABLE')) then
        call blk%fail('VARIABLE is only used with TYPE=FIELD', err)
@@ -351,6 +243,13 @@ contains
        st%stress_block = blk
     case ('SOLUTION')
        path%initial_state = values
+    case ('TEMPERATURE')
+       if (size(values) /= 1) then
+          call blk%fail('*INITIAL CONDITIONS, TYPE=TEMPERATURE takes one value (the point''s ' // &
+               'temperature)', err)
+          return
+       end if
+       path%temperature = values(1)
     case ('FIELD')
        call blk%get_integer('VARIABLE', var, err, default=1, minimum=1)
        if (err%raised) return
@@ -578,26 +477,13 @@ contains
   !> What must be there once every block is read.
   subroutine final_checks(deck, mat, path, st, err)
     type(keyword_deck_t), intent(in) :: deck
-    type(matpoint_material_t), intent(inout) :: mat
+    type(material_t), intent(inout) :: mat
     type(matpoint_path_t), intent(inout) :: path
     type(build_state_t), intent(in) :: st
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: file
 
-    file = '<input>'
-    if (deck%n_blocks > 0) file = deck%blocks(1)%file
-    if (.not. st%have_material) then
-       call raise_error(file, 0, 'no *MATERIAL in the input', err)
-       return
-    end if
-    if (.not. st%have_props) then
-       call st%material_block%fail('*MATERIAL, NAME=' // mat%name // ' has no *USER MATERIAL', err)
-       return
-    end if
-    if (.not. st%have_density) then
-       call st%material_block%fail('*MATERIAL, NAME=' // mat%name // ' has no *DENSITY', err)
-       return
-    end if
+    file = deck_file(deck)
     if (.not. st%have_test) then
        call raise_error(file, 0, 'no *TEST in the input', err)
        return
@@ -618,7 +504,8 @@ contains
           return
        end if
     end if
-    mat%nfieldv = st%fields_declared
+    ! The VUMAT gets every field the input defines (FIELDS= of *USER DEFINED FIELD or the
+    ! highest VARIABLE= of *INITIAL CONDITIONS, TYPE=FIELD), as in Abaqus.
     if (allocated(path%initial_field)) mat%nfieldv = max(mat%nfieldv, size(path%initial_field))
   end subroutine final_checks
 

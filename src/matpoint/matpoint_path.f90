@@ -52,6 +52,7 @@ module matpoint_path
      real(dp) :: initial_stress(max_components) = 0.0_dp
      real(dp), allocatable :: initial_state(:)   !< first SDVs (rest zero)
      real(dp), allocatable :: initial_field(:)   !< first field variables (rest zero)
+     real(dp) :: temperature = 0.0_dp            !< tempOld = tempNew of every call
      integer :: n_stages = 0
      type(matpoint_stage_t), allocatable :: stages(:)
      real(dp) :: tolerance = 1.0e-12_dp      !< mixed control: relative to the stress scale

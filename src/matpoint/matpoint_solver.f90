@@ -21,11 +21,11 @@
 module matpoint_solver
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use matpoint_material, only: matpoint_material_t
+  use model_materials, only: material_t
   use matpoint_path, only: matpoint_path_t, matpoint_stage_t, control_strain, control_stress, &
        control_stress_hold, component_label
-  use matpoint_vumat_door, only: vumat_block_t, call_vumat_block, call_vusdfld_block, &
-       packaging_moduli
+  use matpoint_block, only: point_block_t
+  use material_door, only: checked_packaging_moduli
   use matpoint_dense_solve, only: solve_dense
   implicit none
   private
@@ -63,7 +63,7 @@ contains
 
   !> Run the whole path. On error `err` (or stderr + stop) says where and why.
   subroutine run_material_point(mat, path, history, err)
-    type(matpoint_material_t), intent(in) :: mat
+    type(material_t), intent(in) :: mat
     type(matpoint_path_t), intent(in) :: path
     type(matpoint_history_t), intent(out) :: history
     type(error_t), intent(inout), optional :: err
@@ -74,14 +74,12 @@ contains
   end subroutine run_material_point
 
   subroutine run_path(mat, path, history, err)
-    type(matpoint_material_t), intent(in) :: mat
+    type(material_t), intent(in) :: mat
     type(matpoint_path_t), intent(in) :: path
     type(matpoint_history_t), intent(inout) :: history
     type(error_t), intent(inout) :: err
     type(point_t) :: pt
     integer :: ncomp, nrows, s, row
-    logical :: ok
-    character(len=160) :: msg
 
     ncomp = path%ncomp()
     call check_inputs(mat, path, err)
@@ -98,15 +96,9 @@ contains
     nrows = 1 + sum(path%stages(1:path%n_stages)%n_increments)
     call allocate_history(history, nrows, ncomp, mat%nstatev, mat%nfieldv)
 
-    call packaging_moduli(mat, ncomp, pt%field, &
-         path%stages(1)%duration / path%stages(1)%n_increments, history%two_g, history%bulk, ok)
-    if (.not. ok) then
-       write (msg, '(a,es12.5,a,es12.5,a)') 'the VUMAT''s packaging call (totalTime = 0) did '// &
-            'not return a positive elastic response (2G = ', history%two_g, ', K = ', &
-            history%bulk, ')'
-       call raise_error('material ' // trim(mat%name), 0, trim(msg), err)
-       return
-    end if
+    call checked_packaging_moduli(mat, ncomp, pt%field, &
+         path%stages(1)%duration / path%stages(1)%n_increments, '', history%two_g, history%bulk, err)
+    if (err%raised) return
 
     row = 1
     call record(history, row, pt, 0, 0)
@@ -117,13 +109,13 @@ contains
   end subroutine run_path
 
   subroutine check_inputs(mat, path, err)
-    type(matpoint_material_t), intent(in) :: mat
+    type(material_t), intent(in) :: mat
     type(matpoint_path_t), intent(in) :: path
     type(error_t), intent(inout) :: err
     integer :: s
 
     if (.not. allocated(mat%props)) then
-       call raise_error('', 0, 'the material has no *USER MATERIAL constants', err)
+       call raise_error('', 0, 'the material has no constants (props)', err)
        return
     end if
     if (path%n_stages < 1) then
@@ -200,7 +192,7 @@ contains
 
   !> All increments of stage `s`.
   subroutine run_stage(mat, path, s, history, pt, row, err)
-    type(matpoint_material_t), intent(in) :: mat
+    type(material_t), intent(in) :: mat
     type(matpoint_path_t), intent(in) :: path
     integer, intent(in) :: s
     type(matpoint_history_t), intent(inout) :: history
@@ -208,7 +200,7 @@ contains
     integer, intent(inout) :: row
     type(error_t), intent(inout) :: err
     type(matpoint_stage_t) :: stage
-    type(vumat_block_t) :: blk
+    type(point_block_t) :: blk
     integer :: ncomp, nu, i, j, inc, iterations
     integer, allocatable :: iu(:)
     real(dp), allocatable :: sig_start(:), target_end(:), target(:), de(:), c_el(:, :)
@@ -241,7 +233,7 @@ contains
        end if
     end do
 
-    call blk%init(1 + nu, ncomp, mat%nstatev, mat%nfieldv)
+    call blk%init(1 + nu, ncomp, mat, path%temperature)
     allocate (de(ncomp))
     have_prev = .false.
     de_u_prev = 0.0_dp
@@ -292,9 +284,9 @@ contains
 
   !> Newton iterations of one increment; on success `pt` holds the new state.
   subroutine increment_newton(mat, path, blk, pt, iu, target, c_el, dt, de, iterations, err)
-    type(matpoint_material_t), intent(in) :: mat
+    type(material_t), intent(in) :: mat
     type(matpoint_path_t), intent(in) :: path
-    type(vumat_block_t), intent(inout) :: blk
+    type(point_block_t), intent(inout) :: blk
     type(point_t), intent(inout) :: pt
     integer, intent(in) :: iu(:)
     real(dp), intent(in) :: target(:), c_el(:, :), dt
@@ -326,23 +318,22 @@ contains
        ! stress level, large against round-off (differences of O(scale) numbers).
        h = fd_relative_step * max(maxval(abs(de)), scale / c_el(1, 1))
        call blk%set_point(1, mat%density, pt%strain, de, pt%stress, pt%state, &
-            pt%field, pt%field, pt%ener_intern, pt%ener_inelas)
+            pt%field, pt%ener_intern, pt%ener_inelas)
        do j = 1, nu
           de_k = de
           de_k(iu(j)) = de_k(iu(j)) + h
           call blk%set_point(1 + j, mat%density, pt%strain, de_k, pt%stress, pt%state, &
-               pt%field, pt%field, pt%ener_intern, pt%ener_inelas)
+               pt%field, pt%ener_intern, pt%ener_inelas)
        end do
-       if (mat%user_field) call call_vusdfld_block(blk, mat, t_new, t_new, dt)
-       call call_vumat_block(blk, mat, t_new, t_new, dt)
-       if (.not. all_finite(blk%stress_new)) then
+       call blk%call_material(mat, t_new, dt)
+       if (.not. all_finite(blk%stress)) then
           call raise_error('', 0, 'the VUMAT returned a non-finite stress', err)
           return
        end if
        if (nu == 0) exit
-       r = blk%stress_new(1, iu) - target
+       r = blk%stress(1, iu) - target
        res = maxval(abs(r))
-       res_tol = path%tolerance * max(scale, maxval(abs(blk%stress_new(1, :))))
+       res_tol = path%tolerance * max(scale, maxval(abs(blk%stress(1, :))))
        if (res <= res_tol) exit
        if (iter == path%max_iterations) then
           write (msg, '(a,i0,a,es10.3,a,es10.3,a)') 'mixed control did not converge in ', &
@@ -353,7 +344,7 @@ contains
        end if
        if (iter == 1 .or. res < fast_ratio * res_prev) then
           do j = 1, nu
-             jac(:, j) = (blk%stress_new(1 + j, iu) - blk%stress_new(1, iu)) / h
+             jac(:, j) = (blk%stress(1 + j, iu) - blk%stress(1, iu)) / h
           end do
        else
           ! Slow progress means the answer sits on a kink of the stress response (a
@@ -382,11 +373,11 @@ contains
 
     ! accept point 1
     pt%strain = pt%strain + de
-    pt%stress = blk%stress_new(1, :)
-    pt%state = blk%state_new(1, :)
-    pt%field = blk%field_new(1, :)
-    pt%ener_intern = blk%ener_intern_new(1)
-    pt%ener_inelas = blk%ener_inelas_new(1)
+    pt%stress = blk%stress(1, :)
+    pt%state = blk%state(1, 1:mat%nstatev)
+    pt%field = blk%field(1, 1:mat%nfieldv)
+    pt%ener_intern = blk%ener_intern(1)
+    pt%ener_inelas = blk%ener_inelas(1)
     pt%time = t_new
   end subroutine increment_newton
 

@@ -22,6 +22,8 @@ module model_materials
      real(dp) :: density = 0
      real(dp), allocatable :: props(:)
      integer :: nstatev = 0                      !< *DEPVAR
+     !> Output names of the state variables from *DEPVAR lines ('' where none given)
+     character(len=name_length), allocatable :: sdv_names(:)
      integer :: nfieldv = 0                      !< 1 with *USER DEFINED FIELD (field 1), else 0
      logical :: user_field = .false.             !< call vusdfld before vumat
      logical :: user_material = .false.          !< props come from *USER MATERIAL

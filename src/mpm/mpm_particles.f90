@@ -1,7 +1,7 @@
 !> Particles in blocks: each block holds at most `particle_block_size` particles of one
 !> material, every per-particle array stored (particle, component) so that a block's stress,
 !> state and field arrays are exactly the `(nblock, n)` arrays the VUMAT receives (the same
-!> door as the element blocks, src/material/material_vumat_call.f90).
+!> door as the element blocks, src/material/material_door.f90).
 !>
 !> Arrays always have exactly `count` rows (the VUMAT reads them with leading dimension
 !> nblock); removing (outflow) or adding (inflow) particles repacks the block's arrays. That

@@ -8,7 +8,7 @@
 !>   MUSL remap   p_I = Σ S m v_p, v_I = p_I/m_I, walls again; L_p = Σ v_I ⊗ ∇S         [g2p, walls]
 !>   stress       F ← (I + LΔt) F; Green–Naghdi frame R from F (fem_corotation, as elements);
 !>                strainInc = R_{n+½}ᵀ sym(L)Δt R_{n+½}, relSpinInc; VUSDFLD/VUMAT on the
-!>                block exactly as for element blocks (driver_vumat_call)         [kinematics, material]
+!>                block exactly as for element blocks (material_door)             [kinematics, material]
 !>   outflow      particles below the outflow level leave (mass, time counted)     [outflow]
 !>   inflow       layers of particles at the top keep the free surface level      [inflow]
 !>
@@ -44,7 +44,7 @@ module mpm_run
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, &
        mpm_restart_outputs
-  use driver_vumat_call, only: vumat_work_t, vumat_work_init, call_material, checked_packaging_modulus
+  use material_door, only: vumat_work_t, vumat_work_init, call_material, checked_packaging_modulus
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
   use output_timer, only: timer_set_t, timer_init, timer_register, timer_start, timer_stop, timer_report, &

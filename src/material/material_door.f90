@@ -1,5 +1,12 @@
-!> The solver's side of the VUMAT/VUSDFLD door for element and particle blocks (both techniques
-!> call materials through here; it sits below them, docs/architecture.md).
+!> The material door: the one call path from the solvers to a material. Elements (src/driver),
+!> MPM particles (src/mpm) and the material-point driver (src/matpoint) call a material only
+!> here, with the `material_t` the scene reader built (docs/user_subroutines.md, src/material/
+!> README.md).
+!>
+!> It owns: one increment of a block ([VUSDFLD +] VUMAT with the full Abaqus argument contract:
+!> jblock, coordMp, charLength, density, strainInc, relSpinInc, temperatures, stretch and defgrad
+!> old/new, fields, stress, state, energies), and Abaqus's packaging call with its result checked
+!> (a stiffness that is not positive and finite stops with the material's name).
 !>
 !> vumat and vusdfld are called through implicit interfaces, exactly as Abaqus calls user code;
 !> material_entry says whose (ours, or the --user library's for a *USER MATERIAL). The first
@@ -12,12 +19,13 @@
 !> With a user field, vusdfld runs first on the same block with the start-of-increment stress
 !> and logarithmic strain available to vgetvrm; its fields become the vumat's fieldNew and its
 !> state the vumat's stateOld.
-module material_vumat_call
+module material_door
   use material_kinds, only: dp
-  use error_report, only: raise_error
+  use error_report, only: error_t, raise_error
   use abaqus_host, only: host_set_block, host_set_block_extra
   use model_materials, only: material_t
   use material_entry, only: vumat_entry, vusdfld_entry
+  use material_kinematics, only: stretch_from_log_strain, defgrad_from_stretch
   implicit none
   private
 
@@ -35,6 +43,7 @@ module material_vumat_call
   end type vumat_work_t
 
   public :: vumat_work_init, call_material, packaging_modulus, checked_packaging_modulus
+  public :: packaging_moduli, checked_packaging_moduli
 
 contains
 
@@ -257,22 +266,122 @@ contains
 
   !> packaging_modulus, stopping with the material's name (where it is defined) when the VUMAT's
   !> answer is no stiffness: zero, negative, NaN or infinite (a stable increment from it would be
-  !> meaningless; Abaqus makes this check on its own packaging call).
-  function checked_packaging_modulus(mat, ncomp, nshr, file) result(modulus)
+  !> meaningless; Abaqus makes this check on its own packaging call). With `err` the error is
+  !> recorded there instead (tests).
+  function checked_packaging_modulus(mat, ncomp, nshr, file, err) result(modulus)
     type(material_t), intent(in) :: mat
     integer, intent(in) :: ncomp, nshr
     character(len=*), intent(in) :: file
+    type(error_t), intent(inout), optional :: err
     real(dp) :: modulus
-    character(len=32) :: text
+    character(len=16) :: value
 
     modulus = packaging_modulus(mat, ncomp, nshr)
-    if (modulus > 0 .and. modulus <= huge(1.0_dp)) return
-    write (text, '(es12.4)') modulus
-    call raise_error(file, 0, 'material ' // trim(mat%name) // ' (defined at ' // trim(mat%source) // &
-         '): its VUMAT answered the packaging call (a strain increment 1e-6 in direction 11 at ' // &
-         'stepTime = totalTime = 0) with the stiffness ' // trim(adjustl(text)) // '; expected a positive, ' // &
-         'finite elastic modulus (stress from strainInc or defgradNew; see docs/user_subroutines.md)')
+    if (stiffness_ok(modulus)) return
+    write (value, '(es12.4)') modulus
+    call refuse_stiffness(mat, file, 'a strain increment 1e-6 in direction 11', &
+         'the stiffness ' // trim(adjustl(value)), 'a positive, finite elastic modulus', err)
   end function checked_packaging_modulus
+
+  !> packaging_moduli, stopping (or recording in `err`) as checked_packaging_modulus does when
+  !> 2G or K is not a positive, finite number.
+  subroutine checked_packaging_moduli(mat, ncomp, field, dt, file, two_g, bulk, err)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: ncomp
+    real(dp), intent(in) :: field(:), dt
+    character(len=*), intent(in) :: file
+    real(dp), intent(out) :: two_g, bulk
+    type(error_t), intent(inout), optional :: err
+    character(len=16) :: shear, bulk_value
+
+    call packaging_moduli(mat, ncomp, field, dt, two_g, bulk)
+    if (stiffness_ok(two_g) .and. stiffness_ok(bulk)) return
+    write (shear, '(es12.4)') two_g
+    write (bulk_value, '(es12.4)') bulk
+    call refuse_stiffness(mat, file, 'a volumetric strain increment -3e-6 and the same with a shear ' // &
+         '1e-7', '2G = ' // trim(adjustl(shear)) // ', K = ' // trim(adjustl(bulk_value)), &
+         'a positive, finite shear and bulk modulus', err)
+  end subroutine checked_packaging_moduli
+
+  !> A positive, finite modulus. NaN is tested first: an ordered comparison with NaN raises
+  !> the invalid flag, which the debug build traps.
+  pure logical function stiffness_ok(modulus)
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    real(dp), intent(in) :: modulus
+
+    stiffness_ok = .false.
+    if (ieee_is_finite(modulus)) stiffness_ok = modulus > 0
+  end function stiffness_ok
+
+  !> The packaging call's error: the material, where it is defined, the probe and the answer.
+  subroutine refuse_stiffness(mat, file, probe, answer, expected, err)
+    type(material_t), intent(in) :: mat
+    character(len=*), intent(in) :: file, probe, answer, expected
+    type(error_t), intent(inout), optional :: err
+
+    call raise_error(file, 0, 'material ' // trim(mat%name) // ' (defined at ' // trim(mat%source) // &
+         '): its VUMAT answered the packaging call (' // probe // ' at stepTime = totalTime = 0) ' // &
+         'with ' // answer // '; expected ' // expected // ' (stress from strainInc or defgradNew; ' // &
+         'see docs/user_subroutines.md)', err)
+  end subroutine refuse_stiffness
+
+  !> The two-point packaging call of the material-point driver: from a stress-free state at
+  !> stepTime = totalTime = 0, point 1 a volumetric compression Δε_ii = −δ gives K, point 2 the
+  !> same plus a tensor shear 0.1δ in component 12 gives 2G (δ = 1e-6). The kinematic arrays are
+  !> those of the strain increment from rest (material_kinematics), the density the current one
+  !> at mid-increment (ρ0 exp(−tr ε_mid)); the VUMAT's answers are then thrown away.
+  subroutine packaging_moduli(mat, ncomp, field, dt, two_g, bulk)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: ncomp
+    real(dp), intent(in) :: field(:), dt
+    real(dp), intent(out) :: two_g, bulk
+    real(dp), parameter :: delta = 1.0e-6_dp
+    integer, parameter :: np = 2
+    real(dp) :: strain(np, ncomp), spin(np, ncomp - 3), stretch_old(np, ncomp), stretch_new(np, ncomp)
+    real(dp) :: defgrad_old(np, 2 * ncomp - 3), defgrad_new(np, 2 * ncomp - 3)
+    real(dp) :: stress_old(np, ncomp), stress_new(np, ncomp), state_old(np, max(1, mat%nstatev))
+    real(dp) :: state_new(np, max(1, mat%nstatev)), fields(np, max(1, mat%nfieldv))
+    real(dp) :: coord(np, 3), zero(np), e_new(np), ei_new(np), density(np), char_length(np)
+    real(dp) :: zero_c(ncomp), u(ncomp), f(2 * ncomp - 3), dsig(ncomp)
+    integer :: k
+    procedure(), pointer :: umat
+
+    umat => vumat_entry(mat%user_code)
+    zero_c = 0
+    do k = 1, np
+       strain(k, :) = 0
+       strain(k, 1:3) = -delta
+       if (k == 2) strain(k, 4) = 0.1_dp * delta
+       call stretch_from_log_strain(ncomp, zero_c, u)
+       call defgrad_from_stretch(ncomp, u, f)
+       stretch_old(k, :) = u
+       defgrad_old(k, :) = f
+       call stretch_from_log_strain(ncomp, strain(k, :), u)
+       call defgrad_from_stretch(ncomp, u, f)
+       stretch_new(k, :) = u
+       defgrad_new(k, :) = f
+       density(k) = mat%density * exp(-(0.5_dp * strain(k, 1) + 0.5_dp * strain(k, 2) + 0.5_dp * strain(k, 3)))
+       fields(k, :) = 0
+       fields(k, 1:min(size(field), mat%nfieldv)) = field(1:min(size(field), mat%nfieldv))
+    end do
+    spin = 0
+    stress_old = 0
+    stress_new = 0
+    state_old = 0
+    state_new = 0
+    coord = 0
+    zero = 0
+    e_new = 0
+    ei_new = 0
+    char_length = 1
+    call umat([np, 1, 1, 1, 1, 1], 3, ncomp - 3, mat%nstatev, mat%nfieldv, size(mat%props), 0, 0.0_dp, &
+         0.0_dp, dt, mat%vumat_name, coord, char_length, mat%props, density, strain, spin, zero, &
+         stretch_old, defgrad_old, fields, stress_old, state_old, zero, zero, zero, stretch_new, &
+         defgrad_new, fields, stress_new, state_new, e_new, ei_new)
+    dsig = stress_new(1, :)
+    bulk = (dsig(1) + dsig(2) + dsig(3)) / 3.0_dp / (-3.0_dp * delta)
+    two_g = stress_new(2, 4) / (0.1_dp * delta)
+  end subroutine packaging_moduli
 
   !> Abaqus's packaging call: a tiny uniaxial strain increment from a stress-free state at
   !> stepTime = totalTime = 0; Δσ11/Δε11 is the P-wave modulus λ + 2G that sets the wave
@@ -322,4 +431,4 @@ contains
          state_new, e_new, ei_new)
     modulus = stress_new(1, 1) / probe
   end function packaging_modulus
-end module material_vumat_call
+end module material_door
