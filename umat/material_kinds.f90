@@ -1,13 +1,10 @@
-!> Real kinds and small numeric constants shared by every material kernel.
-!> The material layer depends on nothing else in bulkflow, so it owns the kind
-!> definitions; the solver reuses them from here.
+!> The kinds of the material kernels: the names of src/base/base_kinds.f90, re-exported. The
+!> kernels keep this one name so that they read the same in our tree, in the single Abaqus file
+!> and in CalculiX; the solver takes its kinds from base_kinds directly.
 module material_kinds
-  use, intrinsic :: iso_fortran_env, only: real64
+  use base_kinds, only: dp, pi, deg_to_rad, rad_to_deg
   implicit none
   private
 
-  integer, parameter, public :: dp = real64
-  real(dp), parameter, public :: pi = 3.14159265358979323846264338327950288_dp
-  real(dp), parameter, public :: deg_to_rad = pi / 180.0_dp
-  real(dp), parameter, public :: rad_to_deg = 180.0_dp / pi
+  public :: dp, pi, deg_to_rad, rad_to_deg
 end module material_kinds

@@ -309,9 +309,7 @@ contains
     type(element_work_t), intent(inout) :: w
     integer, intent(in) :: nb, nd, ne
     real(dp), intent(in) :: dt, b1, b2
-    integer :: e, nc, ns, a, i, hourglass_kind
-    real(dp) :: hourglass_coefficient
-    character(len=64) :: text
+    integer :: nc, ns
     logical :: plane, bulk, axisym
 
     nc = solver%ncomp
@@ -319,51 +317,7 @@ contains
     ! plane: the 2D paths (plane rotation, fused kernels); axisym: CAX4R's own kernels among them
     axisym = m%mesh%element_type == element_cax4r
     plane = m%mesh%element_type == element_cpe4r .or. axisym
-    if (axisym) then
-       call cax4r_increment_kinematics(nb, w%xe_old, w%du, blk%bmat_ref, blk%volume_ref, &
-            default_min_volume_ratio, m%materials(blk%material)%density, blk%rotation, w%volume_mid, &
-            w%volume_abs, w%area_mid, w%density, w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, &
-            w%bhoop_new, w%char_length, w%reason, w%r_mid, w%r_new, w%r_plane, w%f_new, w%strain_corot, &
-            w%rel_spin)
-    else if (plane) then
-       ! Kinematics, inversion check, corotational step and density in one pass.
-       ! The section's thickness and the material's density, from which the set-up formed V0 and
-       ! blk%mass = ρ0 V0 (kinematics forms ρ0 V0 again: the same bits).
-       call cpe4r_increment_kinematics(nb, m%sections(blk%section)%thickness, w%xe_old, w%du, w%xe_ref, &
-            default_min_volume_ratio, m%materials(blk%material)%density, blk%rotation, w%volume_mid, &
-            w%volume_abs, w%density, &
-            w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, w%char_length, w%reason, &
-            w%r_mid, w%r_new, w%r_plane, w%f_new, w%strain_corot, w%rel_spin)
-    else
-       call c3d8r_kinematics(nb, w%xe_mid(1:nb, :, :), w%du(1:nb, :, :), w%xe_new(1:nb, :, :), &
-            w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), &
-            w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%char_length(1:nb))
-       call check_inversion(nb, nd, ne, w%xe_new(1:nb, :, :), w%volume_new(1:nb), blk%volume_ref, &
-            default_min_volume_ratio, w%reason(1:nb))
-    end if
-    if (any(w%reason(1:nb) /= 0)) then
-       e = findloc(w%reason(1:nb) /= 0, .true., dim=1)
-       ! The reason text is long: numbers go through a small buffer, the message is built by
-       ! concatenation (an internal write of the whole message overflowed its buffer).
-       write (text, '(a,i0,a,es12.5)') 'element ', blk%elem_number(e), ' at total time ', &
-            solver%total_time + dt
-       if (.not. ieee_is_finite(w%volume_new(e))) then
-          ! not an inversion: the motion became NaN or Inf (loads or masses far out of scale)
-          call raise_error(trim(m%input_file), 0, trim(text) // ': its node coordinates became infinite or not a number; ' // &
-               'expected finite motion (look for loads, masses or material constants far out of scale)')
-       end if
-       call raise_error(trim(m%input_file), 0, trim(text) // ': ' // inversion_reason_text(w%reason(e)) // &
-            ' (increment too large, mesh too coarse for the deformation, or material too soft)')
-    end if
-
-    if (.not. plane) then
-       call corotational_increment(nb, nd, ne, blk%bmat_ref, w%xe_mid(1:nb, :, :), w%xe_new(1:nb, :, :), &
-            w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), blk%rotation, w%r_mid(1:nb, :, :), &
-            w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%strain_corot(1:nb, :), w%rel_spin(1:nb, :))
-       ! Current density at mid-increment, as Abaqus passes it (mass is conserved per element).
-       w%volume_abs(1:nb) = abs(w%volume_mid(1:nb))
-       w%density(1:nb) = blk%mass / w%volume_abs(1:nb)
-    end if
+    call block_kinematics(m, solver, blk, w, nb, nd, ne, dt, plane, axisym)
     if (blk%vumat_needs_kinematics) then
        call deformation_gradient(nb, nd, ne, blk%bmat_ref, w%xe_old(1:nb, :, :), w%f_old(1:nb, :, :))
        call vumat_defgrad(nb, nd, w%f_old(1:nb, :, :), w%defgrad_old(1:nb, :))
@@ -438,27 +392,7 @@ contains
     if (bulk) then
        call effects%stop(effect_elements)
        call effects%start(effect_bulk_viscosity)
-       call bulk_viscosity(nb, nc, w%strain_inc(1:nb, :), dt, w%density(1:nb), w%wave_speed(1:nb), &
-            w%char_length(1:nb), w%volume_abs(1:nb), b1, b2, w%sigma_bv(1:nb), w%xi(1:nb), &
-            w%e_bv(1:nb))
-       if (.not. plane) then
-          do e = 1, 3
-             w%stress_force(1:nb, e) = w%stress_force(1:nb, e) + w%sigma_bv(1:nb)
-          end do
-       end if
-       ! ALLVD with the trapezoidal rule, like the material's stress power: the pressure found now
-       ! acts in the forces at t_{n+1}, the previous one in those at t_n, and the balance charges
-       ! the work of the forces as ½ (f_n + f_{n+1})·Δu. The kernel's σ_bv^{n+½} tr Δε V alone
-       ! overstates ALLVD where the rate jumps (a wave front: 0.3 % of the energies).
-       do e = 1, nb
-          w%e_bv(e) = 0.5_dp * (blk%sigma_bv(e) + w%sigma_bv(e)) * (w%strain_inc(e, 1) + w%strain_inc(e, 2) &
-               + w%strain_inc(e, 3)) * abs(w%volume_mid(e))
-       end do
-       ! σ_bv becomes the block's by exchanging the arrays (both have exactly nb elements).
-       call move_alloc(blk%sigma_bv, w%sigma_bv_swap)
-       call move_alloc(w%sigma_bv, blk%sigma_bv)
-       call move_alloc(w%sigma_bv_swap, w%sigma_bv)
-       solver%e_viscous = solver%e_viscous + sum(w%e_bv(1:nb))
+       call block_bulk_viscosity(blk, w, nb, nc, dt, b1, b2, plane, solver%e_viscous)
        call effects%stop(effect_bulk_viscosity)
        call effects%start(effect_elements)
     end if
@@ -478,46 +412,7 @@ contains
     if (effects%active(effect_hourglass)) then
        call effects%stop(effect_elements)
        call effects%start(effect_hourglass)
-       ! The hourglass form and coefficient of this block's section (a block has one section).
-       ! Before, every element used the first section's, whatever its own *SECTION CONTROLS said.
-       hourglass_kind = m%sections(blk%section)%hourglass
-       hourglass_coefficient = m%sections(blk%section)%hourglass_coefficient
-       if (hourglass_coefficient <= 0) hourglass_coefficient = merge(default_hourglass_viscous_coefficient, &
-            default_hourglass_stiffness_coefficient, hourglass_kind == hourglass_viscous)
-       w%modulus(1:nb) = blk%wave_modulus
-       ! ALLAE as the work of the hourglass forces with the trapezoidal rule, ½ (f_n + f_{n+1})·Δu,
-       ! as the balance charges it (the kernels' C q²/Δt of the viscous form pairs the force of
-       ! t_{n+1} with this increment alone; where the rates change fast — a block released from
-       ! its initial stress — that lag put 1 % of the energies into ETOTAL). For the stiffness form
-       ! the two agree up to the rotation of the increment. blk%force_hg keeps f_{n+1} for the
-       ! next increment: C3D8R the change of fe the hourglass forces make, CPE4R its generalised
-       ! force (cpe4r_hourglass_update).
-       if (axisym) then
-          call cax4r_hourglass_update(nb, w%gamma, w%bsq, w%volume_mid, w%area_mid, w%du, dt, w%density, &
-               w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, blk%hourglass, w%fe, &
-               blk%force_hg, w%e_hg_kernel, w%e_hg)
-       else if (plane) then
-          ! One fused kernel: forces, force change and work in one pass over the block.
-          call cpe4r_hourglass_update(nb, m%sections(blk%section)%thickness, w%gamma, w%bsq, w%volume_mid, &
-               w%du, dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, &
-               blk%hourglass, w%fe, blk%force_hg, w%e_hg_kernel, w%e_hg)
-       else
-          w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)
-          call c3d8r_hourglass(nb, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), &
-               w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), hourglass_kind, &
-               hourglass_coefficient, w%r_mid(1:nb, :, :), w%r_new, blk%hourglass, w%fe(1:nb, :, :), &
-               w%e_hg(1:nb))
-          w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :) - w%fe_hg(1:nb, :, :)
-          w%e_hg(1:nb) = 0
-          do a = 1, ne
-             do i = 1, nd
-                w%e_hg(1:nb) = w%e_hg(1:nb) + 0.5_dp * (blk%force_hg(:, i, a) + w%fe_hg(1:nb, i, a)) &
-                     * w%du(1:nb, i, a)
-             end do
-          end do
-          blk%force_hg = w%fe_hg(1:nb, :, :)
-       end if
-       solver%e_artificial = solver%e_artificial + sum(w%e_hg(1:nb))
+       call block_hourglass(m, blk, w, nb, nd, ne, dt, plane, axisym, solver%e_artificial)
        call effects%stop(effect_hourglass)
        call effects%start(effect_elements)
     end if
@@ -532,6 +427,153 @@ contains
        call exchange_rotations(blk%rotation, w%r_new)
     end if
   end subroutine block_increment
+
+  !> The block's kinematics of the increment: strain increment, rotations, the inversion check
+  !> (a stop naming the element), corotational strain and spin, density at mid-increment.
+  subroutine block_kinematics(m, solver, blk, w, nb, nd, ne, dt, plane, axisym)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(in) :: solver
+    type(element_block_t), intent(inout) :: blk
+    type(element_work_t), intent(inout) :: w
+    integer, intent(in) :: nb, nd, ne
+    real(dp), intent(in) :: dt
+    logical, intent(in) :: plane, axisym
+    integer :: e
+    character(len=64) :: text
+
+    if (axisym) then
+       call cax4r_increment_kinematics(nb, w%xe_old, w%du, blk%bmat_ref, blk%volume_ref, &
+            default_min_volume_ratio, m%materials(blk%material)%density, blk%rotation, w%volume_mid, &
+            w%volume_abs, w%area_mid, w%density, w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, &
+            w%bhoop_new, w%char_length, w%reason, w%r_mid, w%r_new, w%r_plane, w%f_new, w%strain_corot, &
+            w%rel_spin)
+    else if (plane) then
+       ! Kinematics, inversion check, corotational step and density in one pass.
+       ! The section's thickness and the material's density, from which the set-up formed V0 and
+       ! blk%mass = ρ0 V0 (kinematics forms ρ0 V0 again: the same bits).
+       call cpe4r_increment_kinematics(nb, m%sections(blk%section)%thickness, w%xe_old, w%du, w%xe_ref, &
+            default_min_volume_ratio, m%materials(blk%material)%density, blk%rotation, w%volume_mid, &
+            w%volume_abs, w%density, &
+            w%gamma, w%bsq, w%strain_inc, w%volume_new, w%bmat_new, w%char_length, w%reason, &
+            w%r_mid, w%r_new, w%r_plane, w%f_new, w%strain_corot, w%rel_spin)
+    else
+       call c3d8r_kinematics(nb, w%xe_mid(1:nb, :, :), w%du(1:nb, :, :), w%xe_new(1:nb, :, :), &
+            w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), &
+            w%volume_new(1:nb), w%bmat_new(1:nb, :, :), w%char_length(1:nb))
+       call check_inversion(nb, nd, ne, w%xe_new(1:nb, :, :), w%volume_new(1:nb), blk%volume_ref, &
+            default_min_volume_ratio, w%reason(1:nb))
+    end if
+    if (any(w%reason(1:nb) /= 0)) then
+       e = findloc(w%reason(1:nb) /= 0, .true., dim=1)
+       ! The reason text is long: numbers go through a small buffer, the message is built by
+       ! concatenation (an internal write of the whole message overflowed its buffer).
+       write (text, '(a,i0,a,es12.5)') 'element ', blk%elem_number(e), ' at total time ', &
+            solver%total_time + dt
+       if (.not. ieee_is_finite(w%volume_new(e))) then
+          ! not an inversion: the motion became NaN or Inf (loads or masses far out of scale)
+          call raise_error(trim(m%input_file), 0, trim(text) // ': its node coordinates became infinite or not a number; ' // &
+               'expected finite motion (look for loads, masses or material constants far out of scale)')
+       end if
+       call raise_error(trim(m%input_file), 0, trim(text) // ': ' // inversion_reason_text(w%reason(e)) // &
+            ' (increment too large, mesh too coarse for the deformation, or material too soft)')
+    end if
+
+    if (.not. plane) then
+       call corotational_increment(nb, nd, ne, blk%bmat_ref, w%xe_mid(1:nb, :, :), w%xe_new(1:nb, :, :), &
+            w%strain_inc(1:nb, :), w%spin_inc(1:nb, :), blk%rotation, w%r_mid(1:nb, :, :), &
+            w%r_new(1:nb, :, :), w%f_new(1:nb, :, :), w%strain_corot(1:nb, :), w%rel_spin(1:nb, :))
+       ! Current density at mid-increment, as Abaqus passes it (mass is conserved per element).
+       w%volume_abs(1:nb) = abs(w%volume_mid(1:nb))
+       w%density(1:nb) = blk%mass / w%volume_abs(1:nb)
+    end if
+  end subroutine block_kinematics
+
+  !> Bulk viscosity of the block: σ_bv of the increment (the block keeps it) and ALLVD.
+  subroutine block_bulk_viscosity(blk, w, nb, nc, dt, b1, b2, plane, e_viscous)
+    type(element_block_t), intent(inout) :: blk
+    type(element_work_t), intent(inout) :: w
+    integer, intent(in) :: nb, nc
+    real(dp), intent(in) :: dt, b1, b2
+    logical, intent(in) :: plane
+    real(dp), intent(inout) :: e_viscous
+    integer :: e
+
+    call bulk_viscosity(nb, nc, w%strain_inc(1:nb, :), dt, w%density(1:nb), w%wave_speed(1:nb), &
+         w%char_length(1:nb), w%volume_abs(1:nb), b1, b2, w%sigma_bv(1:nb), w%xi(1:nb), &
+         w%e_bv(1:nb))
+    if (.not. plane) then
+       do e = 1, 3
+          w%stress_force(1:nb, e) = w%stress_force(1:nb, e) + w%sigma_bv(1:nb)
+       end do
+    end if
+    ! ALLVD with the trapezoidal rule, like the material's stress power: the pressure found now
+    ! acts in the forces at t_{n+1}, the previous one in those at t_n, and the balance charges
+    ! the work of the forces as ½ (f_n + f_{n+1})·Δu. The kernel's σ_bv^{n+½} tr Δε V alone
+    ! overstates ALLVD where the rate jumps (a wave front: 0.3 % of the energies).
+    do e = 1, nb
+       w%e_bv(e) = 0.5_dp * (blk%sigma_bv(e) + w%sigma_bv(e)) * (w%strain_inc(e, 1) + w%strain_inc(e, 2) &
+            + w%strain_inc(e, 3)) * abs(w%volume_mid(e))
+    end do
+    ! σ_bv becomes the block's by exchanging the arrays (both have exactly nb elements).
+    call move_alloc(blk%sigma_bv, w%sigma_bv_swap)
+    call move_alloc(w%sigma_bv, blk%sigma_bv)
+    call move_alloc(w%sigma_bv_swap, w%sigma_bv)
+    e_viscous = e_viscous + sum(w%e_bv(1:nb))
+  end subroutine block_bulk_viscosity
+
+  !> Hourglass forces of the block (its section's form and coefficient), added to w%fe, and ALLAE.
+  subroutine block_hourglass(m, blk, w, nb, nd, ne, dt, plane, axisym, e_artificial)
+    type(model_t), intent(in) :: m
+    type(element_block_t), intent(inout) :: blk
+    type(element_work_t), intent(inout) :: w
+    integer, intent(in) :: nb, nd, ne
+    real(dp), intent(in) :: dt
+    logical, intent(in) :: plane, axisym
+    real(dp), intent(inout) :: e_artificial
+    integer :: a, i, hourglass_kind
+    real(dp) :: hourglass_coefficient
+
+    ! The hourglass form and coefficient of this block's section (a block has one section).
+    ! Before, every element used the first section's, whatever its own *SECTION CONTROLS said.
+    hourglass_kind = m%sections(blk%section)%hourglass
+    hourglass_coefficient = m%sections(blk%section)%hourglass_coefficient
+    if (hourglass_coefficient <= 0) hourglass_coefficient = merge(default_hourglass_viscous_coefficient, &
+         default_hourglass_stiffness_coefficient, hourglass_kind == hourglass_viscous)
+    w%modulus(1:nb) = blk%wave_modulus
+    ! ALLAE as the work of the hourglass forces with the trapezoidal rule, ½ (f_n + f_{n+1})·Δu,
+    ! as the balance charges it (the kernels' C q²/Δt of the viscous form pairs the force of
+    ! t_{n+1} with this increment alone; where the rates change fast — a block released from
+    ! its initial stress — that lag put 1 % of the energies into ETOTAL). For the stiffness form
+    ! the two agree up to the rotation of the increment. blk%force_hg keeps f_{n+1} for the
+    ! next increment: C3D8R the change of fe the hourglass forces make, CPE4R its generalised
+    ! force (cpe4r_hourglass_update).
+    if (axisym) then
+       call cax4r_hourglass_update(nb, w%gamma, w%bsq, w%volume_mid, w%area_mid, w%du, dt, w%density, &
+            w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, blk%hourglass, w%fe, &
+            blk%force_hg, w%e_hg_kernel, w%e_hg)
+    else if (plane) then
+       ! One fused kernel: forces, force change and work in one pass over the block.
+       call cpe4r_hourglass_update(nb, m%sections(blk%section)%thickness, w%gamma, w%bsq, w%volume_mid, &
+            w%du, dt, w%density, w%modulus, hourglass_kind, hourglass_coefficient, w%r_mid, w%r_new, &
+            blk%hourglass, w%fe, blk%force_hg, w%e_hg_kernel, w%e_hg)
+    else
+       w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :)
+       call c3d8r_hourglass(nb, w%xe_mid(1:nb, :, :), w%volume_mid(1:nb), w%bmat_mid(1:nb, :, :), &
+            w%du(1:nb, :, :), dt, w%density(1:nb), w%modulus(1:nb), hourglass_kind, &
+            hourglass_coefficient, w%r_mid(1:nb, :, :), w%r_new, blk%hourglass, w%fe(1:nb, :, :), &
+            w%e_hg(1:nb))
+       w%fe_hg(1:nb, :, :) = w%fe(1:nb, :, :) - w%fe_hg(1:nb, :, :)
+       w%e_hg(1:nb) = 0
+       do a = 1, ne
+          do i = 1, nd
+             w%e_hg(1:nb) = w%e_hg(1:nb) + 0.5_dp * (blk%force_hg(:, i, a) + w%fe_hg(1:nb, i, a)) &
+                  * w%du(1:nb, i, a)
+          end do
+       end do
+       blk%force_hg = w%fe_hg(1:nb, :, :)
+    end if
+    e_artificial = e_artificial + sum(w%e_hg(1:nb))
+  end subroutine block_hourglass
 
   !> coordMp: the element's integration point (its centroid) at the end of the increment,
   !> x_n + Δu averaged over the nodes; the third column stays 0 in plane strain.

@@ -19,16 +19,15 @@
 !> turns the hourglass force with the element and does no work.
 module fem_hourglass
   use material_kinds, only: dp
+  ! The codes are the model's (a section owns its hourglass control); re-exported for the kernels' callers.
+  use model_materials, only: hourglass_none, hourglass_viscous, hourglass_stiffness, &
+       default_hourglass_viscous_coefficient, default_hourglass_stiffness_coefficient
   implicit none
   private
 
   public :: hourglass_forces
-
-  integer, parameter, public :: hourglass_none = 0
-  integer, parameter, public :: hourglass_viscous = 1
-  integer, parameter, public :: hourglass_stiffness = 2
-  real(dp), parameter, public :: default_hourglass_viscous_coefficient = 0.1_dp
-  real(dp), parameter, public :: default_hourglass_stiffness_coefficient = 0.05_dp
+  public :: hourglass_none, hourglass_viscous, hourglass_stiffness
+  public :: default_hourglass_viscous_coefficient, default_hourglass_stiffness_coefficient
 
 contains
 

@@ -6,15 +6,14 @@
 !>
 !> *SECTION CONTROLS, NAME=..., HOURGLASS=VISCOUS|STIFFNESS with an optional data line
 !> holding Abaqus's hourglass scale factor (default 1): the section's hourglass coefficient
-!> is that factor times our default for the form (fem_hourglass). Abaqus's other forms
+!> is that factor times our default for the form (model_materials). Abaqus's other forms
 !> (RELAX STIFFNESS, ENHANCED, COMBINED) and scale factors are not supported.
 module scene_sections
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t
   use model, only: model_t
-  use model_materials, only: section_t
-  use fem_hourglass, only: hourglass_viscous, hourglass_stiffness, &
+  use model_materials, only: section_t, hourglass_viscous, hourglass_stiffness, &
        default_hourglass_viscous_coefficient, default_hourglass_stiffness_coefficient
   use model_sets, only: find_set
   use scene_layout, only: scene_layout_t

@@ -8,6 +8,14 @@ module model_materials
   implicit none
   private
 
+  !> Hourglass control of a section (*SECTION CONTROLS): the codes the element kernels take
+  !> (fem_hourglass re-exports them) and the default coefficients when HOURGLASS SCALING is 1.
+  integer, parameter, public :: hourglass_none = 0
+  integer, parameter, public :: hourglass_viscous = 1
+  integer, parameter, public :: hourglass_stiffness = 2
+  real(dp), parameter, public :: default_hourglass_viscous_coefficient = 0.1_dp
+  real(dp), parameter, public :: default_hourglass_stiffness_coefficient = 0.05_dp
+
   type, public :: material_t
      character(len=name_length) :: name = ''     !< the scene's name, upper case
      character(len=80) :: vumat_name = ''        !< cmname handed to vumat/vusdfld
@@ -36,8 +44,8 @@ module model_materials
      integer :: material = 0                     !< index into model%materials
      real(dp) :: thickness = 1
      !> Hourglass control (*SECTION CONTROLS, HOURGLASS=VISCOUS|STIFFNESS, HOURGLASS SCALING):
-     !> 1 viscous, 2 stiffness (the fem_hourglass codes); coefficient 0 means the default.
-     integer :: hourglass = 1
+     !> hourglass_viscous or hourglass_stiffness; coefficient 0 means the default.
+     integer :: hourglass = hourglass_viscous
      real(dp) :: hourglass_coefficient = 0
   end type section_t
 end module model_materials

@@ -27,12 +27,13 @@
 !>
 !> Restart: field_writer_open(..., restart_frames=n) reopens the file, keeps frames 0..n-1,
 !> deletes any later frame (written after the checkpoint by the interrupted run) and goes on
-!> with frame n; the XDMF is rebuilt from what the file holds.
+!> with frame n; the XDMF is rebuilt from what the file holds (output_hdf5_frames).
+!>
+!> This module owns the writer and its public procedures; the HDF5 primitives are in
+!> output_hdf5_basics, the collective row transfer in output_hdf5_rows.
 module output_hdf5
-  use, intrinsic :: iso_c_binding, only: c_loc, c_char, c_ptr
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Bcast, &
-       MPI_Alltoall, MPI_Alltoallv, MPI_IN_PLACE, MPI_INTEGER, MPI_LOGICAL, &
-       MPI_DOUBLE_PRECISION, MPI_MAX, MPI_SUM, MPI_INFO_NULL
+       MPI_IN_PLACE, MPI_INTEGER, MPI_LOGICAL, MPI_MAX, MPI_SUM, MPI_INFO_NULL
   use hdf5
   use material_kinds, only: dp
   use error_report, only: error_t, raise_error
@@ -41,6 +42,12 @@ module output_hdf5
   use output_collective, only: agree_on_error
   use output_xdmf, only: xdmf_mesh_t, xdmf_frame_t, xdmf_write, xdmf_add_attribute, &
        xdmf_center_node, xdmf_center_cell
+  use output_hdf5_basics, only: hdf5_error_context, check, create_dataset, write_attr_int, &
+       write_attr_real, write_attr_string
+  use output_hdf5_rows, only: write_rows_real, write_rows_int
+  ! frame_sequence is re-exported: src/mpm/mpm_output.f90 reopens its particle frames with it.
+  use output_hdf5_frames, only: reopen_frames, frame_sequence, frame_path, new_xdmf_frame, &
+       move_frame, coordinates_name
   implicit none
   private
 
@@ -50,12 +57,6 @@ module output_hdf5
   public :: field_writer_close, field_writer_frame_count, frame_sequence
 
   integer, parameter :: format_version = 1
-  !> The file named in messages of failed HDF5 calls (set by each public procedure): such
-  !> failures are fatal, and the low-level helpers that detect them have no writer at hand.
-  character(len=:), allocatable :: error_context
-
-  !> Dataset name reserved for the current coordinates of a frame.
-  character(len=*), parameter :: coordinates_name = 'coordinates'
 
   !> An open field file. Components are private: use the procedures.
   type :: field_writer_t
@@ -173,7 +174,7 @@ contains
        return
     end if
 
-    error_context = w%h5_path
+    call hdf5_error_context(w%h5_path)
     call h5open_f(hdferr)
     call check(hdferr, 'h5open')
     call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, hdferr)
@@ -202,7 +203,7 @@ contains
     allocate (w%frames(16))
 
     if (present(restart_frames)) then
-       call reopen_frames(w, restart_frames, msg)
+       call reopen_frames(w%file, w%n_nodes, w%nen, w%n_elems, restart_frames, w%frames, w%n_frames, msg)
        if (allocated(msg)) then
           call close_handles(w)
           call raise_error(w%h5_path, 0, msg, err)
@@ -335,7 +336,7 @@ contains
     end do
     call create_dataset(w%frame_group, coordinates_name, H5T_IEEE_F64LE, 3, w%n_nodes, dset)
     call write_attr_string(dset, 'center', 'Node')
-    call write_rows_real(w, dset, 3, rows, buf)
+    call write_rows_real(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, 3, rows, buf)
     call h5dclose_f(dset, i)
     w%frames(w%n_frames)%geometry = frame_path(w%n_frames - 1) // '/' // coordinates_name
   end subroutine field_writer_coordinates
@@ -369,7 +370,7 @@ contains
     end do
     call create_dataset(w%frame_group, name, H5T_IEEE_F64LE, ncomp, w%n_nodes, dset)
     call write_attr_string(dset, 'center', 'Node')
-    call write_rows_real(w, dset, ncomp, rows, buf)
+    call write_rows_real(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, ncomp, rows, buf)
     call h5dclose_f(dset, i)
     call xdmf_add_attribute(w%frames(w%n_frames), name, frame_path(w%n_frames - 1) // '/' // name, &
          xdmf_center_node, ncomp)
@@ -407,7 +408,7 @@ contains
     buf = transpose(values)
     call create_dataset(w%frame_group, name, H5T_IEEE_F64LE, ncomp, w%n_elems, dset)
     call write_attr_string(dset, 'center', 'Cell')
-    call write_rows_real(w, dset, ncomp, elem_global, buf)
+    call write_rows_real(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, ncomp, elem_global, buf)
     call h5dclose_f(dset, hdferr)
     call xdmf_add_attribute(w%frames(w%n_frames), name, frame_path(w%n_frames - 1) // '/' // name, &
          xdmf_center_cell, ncomp)
@@ -419,7 +420,7 @@ contains
     type(error_t), intent(inout), optional :: err
 
     if (.not. w%is_open) return
-    error_context = w%h5_path
+    call hdf5_error_context(w%h5_path)
     if (w%frame_open) call field_writer_end_frame(w, err)
     call close_handles(w)
   end subroutine field_writer_close
@@ -433,7 +434,7 @@ contains
   end function field_writer_frame_count
 
   ! ---------------------------------------------------------------------------------------
-  ! Mesh, restart
+  ! Mesh
   ! ---------------------------------------------------------------------------------------
 
   subroutine write_mesh(w, element_type, node_global, node_owned, node_id, x0, elem_global, &
@@ -480,23 +481,23 @@ contains
        ibuf(1, k) = node_id(i)
     end do
     call create_dataset(group, 'coordinates', H5T_IEEE_F64LE, 3, w%n_nodes, dset)
-    call write_rows_real(w, dset, 3, rows, xbuf)
+    call write_rows_real(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, 3, rows, xbuf)
     call h5dclose_f(dset, hdferr)
     call create_dataset(group, 'node_id', H5T_STD_I32LE, 1, w%n_nodes, dset)
-    call write_rows_int(w, dset, 1, rows, ibuf)
+    call write_rows_int(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, 1, rows, ibuf)
     call h5dclose_f(dset, hdferr)
     deallocate (ibuf)
 
     allocate (ibuf(w%nen, size(elem_global)))
     ibuf = conn - 1         ! XDMF topologies index nodes from 0
     call create_dataset(group, 'connectivity', H5T_STD_I32LE, w%nen, w%n_elems, dset)
-    call write_rows_int(w, dset, w%nen, elem_global, ibuf)
+    call write_rows_int(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, w%nen, elem_global, ibuf)
     call h5dclose_f(dset, hdferr)
     deallocate (ibuf)
     allocate (ibuf(1, size(elem_global)))
     ibuf(1, :) = elem_id
     call create_dataset(group, 'element_id', H5T_STD_I32LE, 1, w%n_elems, dset)
-    call write_rows_int(w, dset, 1, elem_global, ibuf)
+    call write_rows_int(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, 1, elem_global, ibuf)
     call h5dclose_f(dset, hdferr)
     call h5gclose_f(group, hdferr)
 
@@ -505,190 +506,6 @@ contains
     call h5gclose_f(group, hdferr)
   end subroutine write_mesh
 
-  !> Reopened file: check the mesh sizes, drop frames >= keep, and rebuild the frame list of
-  !> the XDMF from the kept frames. `msg` allocated on a problem (the same on every rank:
-  !> all ranks read the same file).
-  subroutine reopen_frames(w, keep, msg)
-    type(field_writer_t), intent(inout) :: w
-    integer, intent(in) :: keep
-    character(len=:), allocatable, intent(out) :: msg
-    integer(hsize_t) :: dims(2)
-    integer(hid_t) :: group, fgroup, dset
-    type(xdmf_frame_t), allocatable :: grown(:)
-    integer :: hdferr, storage, n_links, max_corder, f, n_found, a, nd, ncomp
-    integer(size_t) :: name_len
-    character(len=256) :: link_name
-    character(len=4) :: center
-    character(len=6) :: tag
-    real(dp) :: time
-
-    call dataset_dims('/mesh/coordinates', nd, dims)
-    if (nd /= 2 .or. dims(1) /= 3 .or. dims(2) /= w%n_nodes) then
-       msg = 'the file holds a mesh of another size than the model''s (' // &
-            int_to_str(w%n_nodes) // ' nodes expected)'
-       return
-    end if
-    call dataset_dims('/mesh/connectivity', nd, dims)
-    if (nd /= 2 .or. dims(1) /= w%nen .or. dims(2) /= w%n_elems) then
-       msg = 'the file holds a mesh of another size than the model''s (' // &
-            int_to_str(w%n_elems) // ' elements of ' // int_to_str(w%nen) // ' nodes expected)'
-       return
-    end if
-
-    call h5gopen_f(w%file, '/frames', group, hdferr)
-    call check(hdferr, 'opening /frames')
-    call frame_sequence(group, '/frames', keep, n_found, msg)
-    if (allocated(msg)) then
-       call h5gclose_f(group, hdferr)
-       return
-    end if
-    ! Frames written after the checkpoint by the interrupted run go; the restarted run
-    ! writes them again.
-    do f = keep, n_found - 1
-       write (tag, '(i6.6)') f
-       call h5ldelete_f(group, tag, hdferr)
-       call check(hdferr, 'deleting frame ' // tag)
-    end do
-
-    if (size(w%frames) < keep) then
-       allocate (grown(keep))
-       call move_alloc(grown, w%frames)
-    end if
-    do f = 0, keep - 1
-       write (tag, '(i6.6)') f
-       call h5gopen_f(group, tag, fgroup, hdferr)
-       call check(hdferr, 'opening frame ' // tag)
-       call read_attr_real(fgroup, 'total_time', time)
-       call new_xdmf_frame(w%frames(f + 1), tag, time)
-       call h5gget_info_f(fgroup, storage, n_links, max_corder, hdferr)
-       do a = 0, n_links - 1
-          link_name = ''
-          call h5lget_name_by_idx_f(fgroup, '.', H5_INDEX_CRT_ORDER_F, H5_ITER_INC_F, &
-               int(a, hsize_t), link_name, hdferr, size=name_len)
-          call check(hdferr, 'listing frame ' // tag)
-          call h5dopen_f(fgroup, trim(link_name), dset, hdferr)
-          call check(hdferr, 'opening ' // tag // '/' // trim(link_name))
-          call read_attr_string(dset, 'center', center)
-          call dataset_space(dset, nd, dims)
-          call h5dclose_f(dset, hdferr)
-          ncomp = 1
-          if (nd == 2) ncomp = int(dims(1))
-          if (trim(link_name) == coordinates_name) then
-             w%frames(f + 1)%geometry = frame_path(f) // '/' // coordinates_name
-          else if (center == 'Node') then
-             call xdmf_add_attribute(w%frames(f + 1), trim(link_name), &
-                  frame_path(f) // '/' // trim(link_name), xdmf_center_node, ncomp)
-          else
-             call xdmf_add_attribute(w%frames(f + 1), trim(link_name), &
-                  frame_path(f) // '/' // trim(link_name), xdmf_center_cell, ncomp)
-          end if
-       end do
-       call h5gclose_f(fgroup, hdferr)
-    end do
-    call h5gclose_f(group, hdferr)
-    w%n_frames = keep
-
-  contains
-
-    subroutine dataset_dims(path, ndims, d)
-      character(len=*), intent(in) :: path
-      integer, intent(out) :: ndims
-      integer(hsize_t), intent(out) :: d(2)
-      integer(hid_t) :: ds
-      integer :: e
-
-      call h5dopen_f(w%file, path, ds, e)
-      call check(e, 'opening ' // path)
-      call dataset_space(ds, ndims, d)
-      call h5dclose_f(ds, e)
-    end subroutine dataset_dims
-
-  end subroutine reopen_frames
-
-  !> The frames 000000, 000001, ... of an output group (where: its path, for the message) that a
-  !> restart reopens to keep the first `keep`: n_found of them; msg is allocated when they are
-  !> not numbered consecutively or fewer than keep.
-  subroutine frame_sequence(group, where, keep, n_found, msg)
-    integer(hid_t), intent(in) :: group
-    character(len=*), intent(in) :: where
-    integer, intent(in) :: keep
-    integer, intent(out) :: n_found
-    character(len=:), allocatable, intent(inout) :: msg
-    integer :: hdferr, storage, n_links, max_corder, f
-    character(len=6) :: tag
-    logical :: exists
-
-    call h5gget_info_f(group, storage, n_links, max_corder, hdferr)
-    call check(hdferr, 'h5gget_info ' // where)
-    n_found = 0
-    do f = 0, n_links - 1
-       write (tag, '(i6.6)') f
-       call h5lexists_f(group, tag, exists, hdferr)
-       if (.not. exists) exit
-       n_found = n_found + 1
-    end do
-    if (n_found /= n_links) then
-       msg = where // ' holds ' // int_to_str(n_links) // ' entries but its frames 000000.. are ' // &
-            'not numbered consecutively'
-    else if (n_found < keep) then
-       msg = 'cannot restart at frame ' // int_to_str(keep) // ': the file holds only ' // &
-            int_to_str(n_found) // ' frames'
-    end if
-  end subroutine frame_sequence
-
-  !> Rank and dimensions (Fortran order, at most 2) of a dataset.
-  subroutine dataset_space(dset, ndims, dims)
-    integer(hid_t), intent(in) :: dset
-    integer, intent(out) :: ndims
-    integer(hsize_t), intent(out) :: dims(2)
-    integer(hsize_t) :: maxdims(2)
-    integer(hid_t) :: space
-    integer :: hdferr
-
-    dims = 0
-    call h5dget_space_f(dset, space, hdferr)
-    call h5sget_simple_extent_ndims_f(space, ndims, hdferr)
-    if (ndims >= 1 .and. ndims <= 2) then
-       call h5sget_simple_extent_dims_f(space, dims(1:ndims), maxdims(1:ndims), hdferr)
-    end if
-    call h5sclose_f(space, hdferr)
-  end subroutine dataset_space
-
-  ! ---------------------------------------------------------------------------------------
-  ! Helpers
-  ! ---------------------------------------------------------------------------------------
-
-  pure function frame_path(index) result(path)
-    integer, intent(in) :: index
-    character(len=:), allocatable :: path
-    character(len=6) :: tag
-
-    write (tag, '(i6.6)') index
-    path = '/frames/' // tag
-  end function frame_path
-
-  subroutine new_xdmf_frame(frame, tag, time)
-    type(xdmf_frame_t), intent(out) :: frame
-    character(len=*), intent(in) :: tag
-    real(dp), intent(in) :: time
-
-    frame%name = 'frame_' // tag
-    frame%time = time
-    frame%geometry = '/mesh/coordinates'
-    frame%n_attributes = 0
-  end subroutine new_xdmf_frame
-
-  !> Move a frame description (with its allocatable components) without copying the strings.
-  subroutine move_frame(from, to)
-    type(xdmf_frame_t), intent(inout) :: from
-    type(xdmf_frame_t), intent(inout) :: to
-
-    to%time = from%time
-    to%n_attributes = from%n_attributes
-    call move_alloc(from%name, to%name)
-    call move_alloc(from%geometry, to%geometry)
-    if (allocated(from%attributes)) call move_alloc(from%attributes, to%attributes)
-  end subroutine move_frame
 
   !> Rank 0 writes the XDMF of the completed frames; the outcome is shared with all ranks.
   subroutine rewrite_xdmf(w, err)
@@ -769,342 +586,6 @@ contains
          name // '": ' // msg, err)
   end function field_agreed
 
-  !> A (nrows, ncomp) dataset, (nrows,) for one component; contiguous, never filled: every
-  !> row is written once, and skipping the fill saves writing the whole dataset twice.
-  subroutine create_dataset(loc, name, file_type, ncomp, nrows, dset)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer(hid_t), intent(in) :: file_type
-    integer, intent(in) :: ncomp
-    integer, intent(in) :: nrows
-    integer(hid_t), intent(out) :: dset
-    integer(hid_t) :: space, dcpl
-    integer :: hdferr
-
-    if (ncomp == 1) then
-       call h5screate_simple_f(1, [int(nrows, hsize_t)], space, hdferr)
-    else
-       call h5screate_simple_f(2, [int(ncomp, hsize_t), int(nrows, hsize_t)], space, hdferr)
-    end if
-    call check(hdferr, 'creating the dataspace of ' // name)
-    call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, hdferr)
-    call h5pset_fill_time_f(dcpl, H5D_FILL_TIME_NEVER_F, hdferr)
-    call h5dcreate_f(loc, name, file_type, space, dset, hdferr, dcpl_id=dcpl)
-    call check(hdferr, 'creating dataset ' // name)
-    call h5pclose_f(dcpl, hdferr)
-    call h5sclose_f(space, hdferr)
-  end subroutine create_dataset
-
-  !> The contiguous block of rows rank `r` writes: rows 1..n split evenly, the first
-  !> mod(n, nranks) ranks taking one more.
-  pure subroutine block_of(n, nranks, r, first, count)
-    integer, intent(in) :: n
-    integer, intent(in) :: nranks
-    integer, intent(in) :: r
-    integer, intent(out) :: first
-    integer, intent(out) :: count
-    integer :: base, rem
-
-    base = n / nranks
-    rem = mod(n, nranks)
-    first = r * base + min(r, rem) + 1
-    count = base
-    if (r < rem) count = base + 1
-  end subroutine block_of
-
-  !> The rank whose block holds row g (the inverse of block_of).
-  pure integer function block_rank(n, nranks, g)
-    integer, intent(in) :: n
-    integer, intent(in) :: nranks
-    integer, intent(in) :: g
-    integer :: base, rem, big
-
-    base = n / nranks
-    rem = mod(n, nranks)
-    big = rem * (base + 1)
-    if (g <= big) then
-       block_rank = (g - 1) / (base + 1)
-    else
-       block_rank = rem + (g - 1 - big) / base
-    end if
-  end function block_rank
-
-  !> Send the packed rows buf(ncomp, size(rows)) (global 1-based, ascending) to the ranks
-  !> whose blocks hold them; on return block(ncomp, count) holds this rank's block of rows
-  !> first..first+count-1.
-  !>
-  !> Why not let every rank write its own rows: a rank's rows are scattered over the file
-  !> (owned nodes of a partition are not numbered consecutively), and an HDF5 1.10
-  !> selection made of many hyperslabs costs time quadratic in their number (10 s for
-  !> 20 000 nodes on two ranks). One all-to-all exchange makes every rank's part one
-  !> contiguous hyperslab, and the collective write is then a plain MPI-IO block write.
-  subroutine redistribute(w, ncomp, nrows, rows, buf, first, count, block)
-    type(field_writer_t), intent(in) :: w
-    integer, intent(in) :: ncomp
-    integer, intent(in) :: nrows
-    integer, intent(in) :: rows(:)
-    real(dp), intent(in) :: buf(:, :)
-    integer, intent(out) :: first
-    integer, intent(out) :: count
-    real(dp), allocatable, intent(out) :: block(:, :)
-    integer, allocatable :: send_counts(:), send_displs(:), recv_counts(:), recv_displs(:)
-    integer, allocatable :: recv_rows(:)
-    real(dp), allocatable :: recv_values(:, :)
-    logical, allocatable :: seen(:)
-    integer :: k, r, p, n_recv
-
-    p = w%nranks
-    allocate (send_counts(0:p - 1), send_displs(0:p - 1), recv_counts(0:p - 1), &
-         recv_displs(0:p - 1))
-    send_counts = 0
-    do k = 1, size(rows)
-       r = block_rank(nrows, p, rows(k))
-       send_counts(r) = send_counts(r) + 1
-    end do
-    call MPI_Alltoall(send_counts, 1, MPI_INTEGER, recv_counts, 1, MPI_INTEGER, w%comm)
-    send_displs(0) = 0
-    recv_displs(0) = 0
-    do r = 1, p - 1
-       send_displs(r) = send_displs(r - 1) + send_counts(r - 1)
-       recv_displs(r) = recv_displs(r - 1) + recv_counts(r - 1)
-    end do
-    n_recv = sum(recv_counts)
-    allocate (recv_rows(n_recv), recv_values(ncomp, n_recv))
-    ! Rows are ascending, so the rows for each destination are consecutive in `rows`.
-    call MPI_Alltoallv(rows, send_counts, send_displs, MPI_INTEGER, recv_rows, recv_counts, &
-         recv_displs, MPI_INTEGER, w%comm)
-    call MPI_Alltoallv(buf, ncomp * send_counts, ncomp * send_displs, MPI_DOUBLE_PRECISION, &
-         recv_values, ncomp * recv_counts, ncomp * recv_displs, MPI_DOUBLE_PRECISION, w%comm)
-
-    call block_of(nrows, p, w%rank, first, count)
-    allocate (block(ncomp, count), seen(count))
-    seen = .false.
-    do k = 1, n_recv
-       r = recv_rows(k) - first + 1
-       ! block_rank sent every row to the block holding it, so r is in range; a row sent
-       ! twice means two ranks claim the same node.
-       if (seen(r)) call raise_error(w%h5_path, 0, 'row ' // &
-            int_to_str(recv_rows(k)) // ' is written by two ranks (node owned twice?)')
-       seen(r) = .true.
-       block(:, r) = recv_values(:, k)
-    end do
-    if (.not. all(seen)) call raise_error(w%h5_path, 0, &
-         'rows left unwritten (a node without owner?)')
-  end subroutine redistribute
-
-  !> Collective write of the packed rows buf(ncomp, size(rows)) of a (nrows, ncomp)
-  !> dataset ((nrows,) for one component), through redistribute.
-  subroutine write_rows_real(w, dset, ncomp, rows, buf)
-    type(field_writer_t), intent(in) :: w
-    integer(hid_t), intent(in) :: dset
-    integer, intent(in) :: ncomp
-    integer, intent(in) :: rows(:)
-    real(dp), intent(in) :: buf(:, :)
-    real(dp), allocatable, target :: block(:, :)
-    real(dp), target :: idle(1)
-    integer(hid_t) :: file_space, mem_space
-    integer :: hdferr, first, count
-
-    call redistribute(w, ncomp, dataset_rows(dset), rows, buf, first, count, block)
-    call block_spaces(dset, ncomp, first, count, file_space, mem_space)
-    idle = 0.0_dp
-    if (count > 0) then
-       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(block), hdferr, mem_space, file_space, w%xfer)
-    else
-       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(idle), hdferr, mem_space, file_space, w%xfer)
-    end if
-    call check(hdferr, 'writing a dataset')
-    call h5sclose_f(mem_space, hdferr)
-    call h5sclose_f(file_space, hdferr)
-  end subroutine write_rows_real
-
-  !> The same for integers (sent as doubles, exact below 2**53).
-  subroutine write_rows_int(w, dset, ncomp, rows, buf)
-    type(field_writer_t), intent(in) :: w
-    integer(hid_t), intent(in) :: dset
-    integer, intent(in) :: ncomp
-    integer, intent(in) :: rows(:)
-    integer, intent(in) :: buf(:, :)
-    real(dp), allocatable :: block(:, :), rbuf(:, :)
-    integer, allocatable, target :: iblock(:, :)
-    integer, target :: idle(1)
-    integer(hid_t) :: file_space, mem_space
-    integer :: hdferr, first, count
-
-    allocate (rbuf(size(buf, 1), size(buf, 2)))
-    rbuf = real(buf, dp)
-    call redistribute(w, ncomp, dataset_rows(dset), rows, rbuf, first, count, block)
-    allocate (iblock(ncomp, count))
-    iblock = nint(block)
-    call block_spaces(dset, ncomp, first, count, file_space, mem_space)
-    idle = 0
-    if (count > 0) then
-       call h5dwrite_f(dset, H5T_NATIVE_INTEGER, c_loc(iblock), hdferr, mem_space, file_space, w%xfer)
-    else
-       call h5dwrite_f(dset, H5T_NATIVE_INTEGER, c_loc(idle), hdferr, mem_space, file_space, w%xfer)
-    end if
-    call check(hdferr, 'writing a dataset')
-    call h5sclose_f(mem_space, hdferr)
-    call h5sclose_f(file_space, hdferr)
-  end subroutine write_rows_int
-
-  !> Number of rows of a dataset (its last Fortran-order dimension).
-  integer function dataset_rows(dset)
-    integer(hid_t), intent(in) :: dset
-    integer(hsize_t) :: dims(2)
-    integer :: ndims
-
-    call dataset_space(dset, ndims, dims)
-    dataset_rows = int(dims(ndims))
-  end function dataset_rows
-
-  !> File and memory dataspaces of the block first..first+count-1; with count = 0 both
-  !> selections are empty (a one-row memory space selecting nothing), so that a rank
-  !> without rows still joins the collective transfer.
-  subroutine block_spaces(dset, ncomp, first, count, file_space, mem_space)
-    integer(hid_t), intent(in) :: dset
-    integer, intent(in) :: ncomp
-    integer, intent(in) :: first
-    integer, intent(in) :: count
-    integer(hid_t), intent(out) :: file_space
-    integer(hid_t), intent(out) :: mem_space
-    integer :: hdferr
-
-    call h5dget_space_f(dset, file_space, hdferr)
-    call check(hdferr, 'getting a file dataspace')
-    if (ncomp == 1) then
-       call h5screate_simple_f(1, [int(max(count, 1), hsize_t)], mem_space, hdferr)
-    else
-       call h5screate_simple_f(2, [int(ncomp, hsize_t), int(max(count, 1), hsize_t)], mem_space, hdferr)
-    end if
-    call check(hdferr, 'creating a memory dataspace')
-    if (count == 0) then
-       call h5sselect_none_f(file_space, hdferr)
-       call h5sselect_none_f(mem_space, hdferr)
-    else if (ncomp == 1) then
-       call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, [int(first - 1, hsize_t)], &
-            [int(count, hsize_t)], hdferr)
-    else
-       call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, [0_hsize_t, int(first - 1, hsize_t)], &
-            [int(ncomp, hsize_t), int(count, hsize_t)], hdferr)
-    end if
-    call check(hdferr, 'selecting rows')
-  end subroutine block_spaces
-
-  ! Attributes: metadata writes are collective in parallel HDF5, so every rank calls these
-  ! with the same value.
-
-  subroutine write_attr_int(loc, name, value)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(in) :: value
-    integer, target :: v
-    integer(hid_t) :: space, attr
-    integer :: hdferr
-
-    v = value
-    call h5screate_f(H5S_SCALAR_F, space, hdferr)
-    call h5acreate_f(loc, name, H5T_STD_I32LE, space, attr, hdferr)
-    call check(hdferr, 'creating attribute ' // name)
-    call h5awrite_f(attr, H5T_NATIVE_INTEGER, c_loc(v), hdferr)
-    call check(hdferr, 'writing attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-    call h5sclose_f(space, hdferr)
-  end subroutine write_attr_int
-
-  subroutine write_attr_real(loc, name, value)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(dp), intent(in) :: value
-    real(dp), target :: v
-    integer(hid_t) :: space, attr
-    integer :: hdferr
-
-    v = value
-    call h5screate_f(H5S_SCALAR_F, space, hdferr)
-    call h5acreate_f(loc, name, H5T_IEEE_F64LE, space, attr, hdferr)
-    call check(hdferr, 'creating attribute ' // name)
-    call h5awrite_f(attr, H5T_NATIVE_DOUBLE, c_loc(v), hdferr)
-    call check(hdferr, 'writing attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-    call h5sclose_f(space, hdferr)
-  end subroutine write_attr_real
-
-  !> A fixed-length, null-padded string attribute (h5py reads it as bytes).
-  subroutine write_attr_string(loc, name, value)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    character(len=*), intent(in) :: value
-    character(kind=c_char), target :: chars(len(value))
-    integer(hid_t) :: space, attr, stype
-    integer :: hdferr, i
-
-    do i = 1, len(value)
-       chars(i) = value(i:i)
-    end do
-    call string_type(len(value), stype)
-    call h5screate_f(H5S_SCALAR_F, space, hdferr)
-    call h5acreate_f(loc, name, stype, space, attr, hdferr)
-    call check(hdferr, 'creating attribute ' // name)
-    call h5awrite_f(attr, stype, c_loc(chars), hdferr)
-    call check(hdferr, 'writing attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-    call h5sclose_f(space, hdferr)
-    call h5tclose_f(stype, hdferr)
-  end subroutine write_attr_string
-
-  subroutine read_attr_real(loc, name, value)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(dp), intent(out) :: value
-    real(dp), target :: v
-    type(c_ptr) :: ptr
-    integer(hid_t) :: attr
-    integer :: hdferr
-
-    call h5aopen_f(loc, name, attr, hdferr)
-    call check(hdferr, 'opening attribute ' // name)
-    ptr = c_loc(v)      ! h5aread_f wants a variable (intent inout), not an expression
-    call h5aread_f(attr, H5T_NATIVE_DOUBLE, ptr, hdferr)
-    call check(hdferr, 'reading attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-    value = v
-  end subroutine read_attr_real
-
-  subroutine read_attr_string(loc, name, value)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    character(len=*), intent(out) :: value
-    character(kind=c_char), target :: chars(len(value))
-    type(c_ptr) :: ptr
-    integer(hid_t) :: attr, stype
-    integer :: hdferr, i
-
-    chars = ' '
-    call string_type(len(value), stype)
-    call h5aopen_f(loc, name, attr, hdferr)
-    call check(hdferr, 'opening attribute ' // name)
-    ptr = c_loc(chars)
-    call h5aread_f(attr, stype, ptr, hdferr)
-    call check(hdferr, 'reading attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-    call h5tclose_f(stype, hdferr)
-    do i = 1, len(value)
-       value(i:i) = chars(i)
-    end do
-  end subroutine read_attr_string
-
-  subroutine string_type(n, stype)
-    integer, intent(in) :: n
-    integer(hid_t), intent(out) :: stype
-    integer :: hdferr
-
-    call h5tcopy_f(H5T_FORTRAN_S1, stype, hdferr)
-    call h5tset_size_f(stype, int(n, size_t), hdferr)
-    call h5tset_strpad_f(stype, H5T_STR_NULLPAD_F, hdferr)
-    call check(hdferr, 'creating a string type')
-  end subroutine string_type
-
   subroutine close_handles(w)
     type(field_writer_t), intent(inout) :: w
     integer :: hdferr
@@ -1122,7 +603,7 @@ contains
     character(len=*), intent(in) :: what
 
     if (.not. w%is_open) call raise_error(what, 0, 'the field writer is not open')
-    error_context = w%h5_path
+    call hdf5_error_context(w%h5_path)
   end subroutine require_open
 
   subroutine require_frame(w, what)
@@ -1133,14 +614,5 @@ contains
     if (.not. w%frame_open) call raise_error(what, 0, 'no frame is open ' // &
          '(call field_writer_frame first)')
   end subroutine require_frame
-
-  !> An HDF5 call failed: an I/O problem we cannot recover from (disk full, permissions,
-  !> a damaged file), so stop with the operation named.
-  subroutine check(hdferr, what)
-    integer, intent(in) :: hdferr
-    character(len=*), intent(in) :: what
-
-    if (hdferr < 0) call raise_error(error_context, 0, 'HDF5: ' // what // ' failed')
-  end subroutine check
 
 end module output_hdf5
