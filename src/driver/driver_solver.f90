@@ -88,8 +88,8 @@ module driver_solver
      real(dp) :: dt = 0, dt_prev = 0                  !< dt_{n+1/2}, dt_{n-1/2}
      real(dp) :: dt_stable = 0                        !< stable increment at t_n (before scaling)
      integer :: dt_element = 0                        !< user number of the controlling element
-     ! Output schedule carried through a restart (driver_checkpoint -> driver_run).
-     real(dp) :: restart_next_field = 0, restart_next_history = 0, restart_energy_reference = 0
+     ! Energy check carried through a restart (driver_checkpoint -> driver_run).
+     real(dp) :: restart_energy_reference = 0
      real(dp) :: restart_energy_peak = 0
      ! Step stop condition (driver_stop_condition): displacements at the step start, the largest
      ! displacement since then over the condition's node set, the kinetic-energy peak of the

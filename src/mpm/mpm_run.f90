@@ -33,14 +33,16 @@ module mpm_run
   use output_timer, only: timer_start, timer_stop
   use output_collective, only: stop_agreed_error
   use output_history, only: history_t, history_open, history_close, history_row_count
+  use output_schedule, only: output_schedule_t, field_schedule, history_schedule, schedule_due, schedule_advance, &
+       schedule_resume
   use parallel_comm, only: comm_rank, comm_size
   implicit none
   private
 
-  !> The output schedule of the running step and the MDR reference of the last history row
-  !> (what a checkpoint saves besides the state).
+  !> The output schedules of the running step (output_schedule: the element driver's rule) and
+  !> the MDR reference of the last history row.
   type :: schedule_t
-     real(dp) :: next_field = 0, next_history = 0, field_dt = 0, history_dt = 0
+     type(output_schedule_t) :: field, history
      real(dp) :: last_row_time = 0, last_row_out = 0
   end type schedule_t
 
@@ -87,11 +89,8 @@ contains
     else
        if (st%rank == 0) call mpm_writer_open(wr, base, st%g, st%nc, nsdv)
        call history_open(hist, base // '_history.csv', columns, comm)
-       call measure(st)
-       call write_frame(st, wr, 1, 0.0_dp)
        sch%last_row_time = 0
        sch%last_row_out = 0
-       call write_history(m, st, hist, sch%last_row_time, sch%last_row_out)
     end if
     call system_clock(clock_last, clock_rate)
     clock_start = clock_last
@@ -105,10 +104,15 @@ contains
        end if
        period = m%steps(s)%period
        eps = 1.0e-12_dp * period
-       call output_intervals(m, s, sch%field_dt, sch%history_dt)
-       if (.not. resumed) then
-          sch%next_field = sch%field_dt
-          sch%next_history = sch%history_dt
+       call field_schedule(m%steps(s), sch%field)
+       call history_schedule(m%steps(s), sch%history)
+       if (resumed) then
+          call schedule_resume(sch%field, st%step_time)
+          call schedule_resume(sch%history, st%step_time)
+       else
+          ! the step's first row and frame: its initial state
+          st%step_increment = 0
+          call increment_outputs(m, st, base, wr, hist, sch, .false.)
        end if
        resumed = .false.
        call mark_wall_nodes(m, st)
@@ -121,9 +125,10 @@ contains
           st%step_time = st%step_time + st%dt
           st%total_time = st%total_time + st%dt
           st%increment = st%increment + 1
+          st%step_increment = st%step_increment + 1
           stop_now = stop_after > 0 .and. st%increment >= stop_after
           call timer_start(fx%timers, fx%id(fx_output))
-          call increment_outputs(m, st, base, wr, hist, sch, period, stop_now)
+          call increment_outputs(m, st, base, wr, hist, sch, stop_now)
           if (progress .and. st%rank == 0) then
              ! rank 0's own clock decides: no collective here (the ranks' clocks differ)
              call system_clock(clock_now)
@@ -187,37 +192,30 @@ contains
     end if
   end subroutine increment
 
-  !> The history row and frame due after an increment, the checkpoint, and the extra row and
-  !> frame of a --stop-after stop.
-  subroutine increment_outputs(m, st, base, wr, hist, sch, period, stop_now)
+  !> The history row and frame due after an increment (or at the step's start, step_increment
+  !> 0), the checkpoint, and the extra row and frame of a --stop-after stop.
+  subroutine increment_outputs(m, st, base, wr, hist, sch, stop_now)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     character(len=*), intent(in) :: base
     type(mpm_writer_t), intent(inout) :: wr
     type(history_t), intent(inout) :: hist
     type(schedule_t), intent(inout) :: sch
-    real(dp), intent(in) :: period
     logical, intent(in) :: stop_now
-    real(dp) :: eps
     logical :: history_due, field_due
 
-    eps = 1.0e-12_dp * period
-    history_due = st%step_time >= sch%next_history - eps .or. st%step_time >= period - eps
-    field_due = st%step_time >= sch%next_field - eps .or. &
-         (st%step_time >= period - eps .and. sch%field_dt < huge(1.0_dp))
+    history_due = schedule_due(sch%history, st%step_time, st%step_increment, st%dt)
+    field_due = schedule_due(sch%field, st%step_time, st%step_increment, st%dt)
     if (history_due) then
        call measure(st)
        call write_history(m, st, hist, sch%last_row_time, sch%last_row_out)
-       do while (sch%next_history <= st%step_time + eps)
-          sch%next_history = sch%next_history + sch%history_dt
-       end do
+       call schedule_advance(sch%history, st%step_time)
     end if
     if (field_due) then
        call write_frame(st, wr, st%step, st%step_time)
-       do while (sch%next_field <= st%step_time + eps)
-          sch%next_field = sch%next_field + sch%field_dt
-       end do
+       call schedule_advance(sch%field, st%step_time)
     end if
+    if (st%step_increment == 0) return
     ! The checkpoint (timed as output) follows the increment's own output and precedes the
     ! extra row and frame of a stop: the uninterrupted run has none there, so a restart
     ! drops them (it keeps the frames and rows the checkpoint counted).
@@ -229,38 +227,6 @@ contains
     end if
     if (stop_now .and. .not. field_due) call write_frame(st, wr, st%step, st%step_time)
   end subroutine increment_outputs
-
-  subroutine output_intervals(m, s, field_dt, history_dt)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: s
-    real(dp), intent(out) :: field_dt, history_dt
-    integer :: j
-
-    field_dt = huge(1.0_dp)
-    history_dt = m%steps(s)%period / 200
-    if (allocated(m%steps(s)%field_outputs)) then
-       do j = 1, size(m%steps(s)%field_outputs)
-          associate (f => m%steps(s)%field_outputs(j))
-            if (f%time_interval > 0) field_dt = min(field_dt, f%time_interval)
-            if (f%number_interval > 0) field_dt = min(field_dt, m%steps(s)%period / f%number_interval)
-          end associate
-       end do
-    end if
-    if (allocated(m%steps(s)%history_outputs)) then
-       if (size(m%steps(s)%history_outputs) > 0) history_dt = huge(1.0_dp)
-       do j = 1, size(m%steps(s)%history_outputs)
-          associate (h => m%steps(s)%history_outputs(j))
-            if (h%time_interval > 0) then
-               history_dt = min(history_dt, h%time_interval)
-            else if (h%number_interval > 0) then
-               history_dt = min(history_dt, m%steps(s)%period / h%number_interval)
-            else
-               history_dt = 0
-            end if
-          end associate
-       end do
-    end if
-  end subroutine output_intervals
 
   ! ------------------------------------------------------------------------------ checkpoint hooks
 
@@ -302,8 +268,7 @@ contains
     sv%wall_force = st%wall_force
     sv%wall_impulse = st%wall_impulse
     sv%wall_force_row = st%wall_force_row
-    sv%next_field = sch%next_field
-    sv%next_history = sch%next_history
+    sv%step_increment = st%step_increment
     sv%last_row_time = sch%last_row_time
     sv%last_row_out = sch%last_row_out
     sv%frames = 0
@@ -359,8 +324,7 @@ contains
     st%wall_force = sv%wall_force
     st%wall_impulse = sv%wall_impulse
     st%wall_force_row = sv%wall_force_row
-    sch%next_field = sv%next_field
-    sch%next_history = sv%next_history
+    st%step_increment = sv%step_increment
     sch%last_row_time = sv%last_row_time
     sch%last_row_out = sv%last_row_out
     if (st%rank == 0) then

@@ -73,6 +73,7 @@ module mpm_state
      logical, allocatable :: on_wall(:)              !< grid nodes of the walls active in this step
      ! time
      integer :: step = 0, increment = 0
+     integer :: step_increment = 0                   !< increments of the running step
      integer(int64) :: particle_steps = 0           !< Σ over increments of the particle count
      real(dp) :: loop_seconds = 0                    !< wall time of the time loop
      real(dp) :: total_time = 0, step_time = 0, dt = 0, dt_stable = 0
