@@ -167,20 +167,27 @@ contains
     integer, intent(in) :: istep
     integer :: j, k
     type(field_output_t) :: f
+    character(len=8), allocatable :: written(:)
 
     if (.not. out%fields_open .or. .not. allocated(m%steps(istep)%field_outputs)) return
     call field_writer_frame(out%fields, istep, solver%step_time, solver%total_time, solver%increment)
     call field_writer_coordinates(out%fields, solver%part%node_global, solver%part%node_owned, &
          solver%x0 + solver%u)
+    ! every variable once, however many of the step's requests ask for it
+    allocate (written(0))
     do j = 1, size(m%steps(istep)%field_outputs)
        f = m%steps(istep)%field_outputs(j)
        if (allocated(f%node_variables)) then
           do k = 1, size(f%node_variables)
+             if (any(written == f%node_variables(k))) cycle
+             written = [written, f%node_variables(k)]
              call write_node_variable(solver, out, trim(f%node_variables(k)))
           end do
        end if
        if (allocated(f%element_variables)) then
           do k = 1, size(f%element_variables)
+             if (any(written == f%element_variables(k))) cycle
+             written = [written, f%element_variables(k)]
              call write_element_variable(m, solver, out, trim(f%element_variables(k)))
           end do
        end if
