@@ -180,14 +180,14 @@ contains
        if (allocated(f%node_variables)) then
           do k = 1, size(f%node_variables)
              if (any(written == f%node_variables(k))) cycle
-             written = [written, f%node_variables(k)]
+             written = [character(len=8) :: written, f%node_variables(k)]
              call write_node_variable(solver, out, trim(f%node_variables(k)))
           end do
        end if
        if (allocated(f%element_variables)) then
           do k = 1, size(f%element_variables)
              if (any(written == f%element_variables(k))) cycle
-             written = [written, f%element_variables(k)]
+             written = [character(len=8) :: written, f%element_variables(k)]
              call write_element_variable(m, solver, out, trim(f%element_variables(k)))
           end do
        end if
