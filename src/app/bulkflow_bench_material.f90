@@ -7,7 +7,7 @@
 !>   model: MC (default), MC-TABLE (angle table + flow function), DP, ELASTIC
 program bulkflow_bench_material
   use, intrinsic :: iso_fortran_env, only: int64, output_unit
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use material_state, only: sdv_yield
   implicit none
   external :: vumat

@@ -9,7 +9,7 @@
 !> line "bulkflow: error: file:line: message" on stderr and exit status 2.
 program bulkflow_matpoint
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: report_and_stop
   use model_materials, only: material_t
   use matpoint_path, only: matpoint_path_t, test_names, test_triaxial, test_biaxial, &

@@ -36,7 +36,7 @@
 !> A point behind the surface is in contact however deep it is (analytical rigid surfaces are
 !> single-sided with unlimited depth).
 module contact_geometry
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_surfaces, only: segment_t, rigid_surface_t, segment_line, segment_arc
   implicit none
   private

@@ -31,7 +31,7 @@
 !> this balances exactly while the forces are steady (a sliding block: to round-off), and to
 !> O(dt^2) per increment otherwise. A sticking node does no frictional work.
 module contact_rigid_wall
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_surfaces, only: rigid_surface_t
   use contact_geometry, only: surface_closest_point, surface_coordinate_scale
   implicit none

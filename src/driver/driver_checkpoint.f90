@@ -9,7 +9,7 @@
 !> does not match) is found alike on every rank (output_checkpoint agrees its errors) and comes
 !> back in err with what was expected; the caller ends the run cleanly (stop_agreed_error).
 module driver_checkpoint
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t
   use model, only: model_t
   use checkpoint_scene, only: put_scene_digest, check_saved_scene
@@ -56,8 +56,8 @@ contains
     call checkpoint_put(ck, 'rigid_u', rigid_array(solver, .true.))
     call checkpoint_put(ck, 'rigid_v', rigid_array(solver, .false.))
     call checkpoint_put(ck, 'scalars', [solver%e_viscous, solver%e_artificial, solver%e_friction, &
-         solver%e_external, solver%step_start, solver%dt_prev, solver%dt_stable, out%next_field, &
-         out%next_history, out%energy_reference, out%energy_peak])
+         solver%e_external, solver%step_start, solver%dt_prev, solver%dt_stable, out%energy_reference, &
+         out%energy_peak])
     call checkpoint_put(ck, 'counters', [solver%step_increment, solver%dt_element])
     ! Mass scaling and the step stop condition (driver_mass_scaling, driver_stop_condition).
     call checkpoint_put(ck, 'mass', solver%mass)
@@ -101,7 +101,7 @@ contains
     type(error_t), intent(inout) :: err
     type(checkpoint_t) :: ck
     type(checkpoint_header_t) :: header
-    real(dp) :: scalars(11)
+    real(dp) :: scalars(9)
     real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
     integer :: counters(2), ib, i
     real(dp) :: stop_scalars(6)
@@ -182,10 +182,9 @@ contains
     end do
     call checkpoint_end_read(ck, err)
     if (err%raised) return
-    solver%restart_next_field = scalars(8)
-    solver%restart_next_history = scalars(9)
-    solver%restart_energy_reference = scalars(10)
-    solver%restart_energy_peak = scalars(11)
+    ! (the output schedule is rebuilt from the step time and increment: output_schedule)
+    solver%restart_energy_reference = scalars(8)
+    solver%restart_energy_peak = scalars(9)
   end subroutine load_checkpoint
 
   !> The digest's hashes as pairs of 32-bit words (the checkpoint stores 32-bit integers).

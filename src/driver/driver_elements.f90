@@ -6,7 +6,7 @@
 module driver_elements
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: raise_error
   use model, only: model_t
   use model_mesh, only: element_cpe4r, element_cax4r

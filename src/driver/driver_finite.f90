@@ -12,7 +12,7 @@
 !> then is the state searched for the first non-finite value.
 module driver_finite
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use driver_solver, only: solver_t
   use error_report, only: error_t

@@ -3,7 +3,7 @@
 !> prepare_step turns the step's global, user-facing lists into local index lists once, so the
 !> increment loop touches only arrays.
 module driver_loads
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_steps, only: bc_velocity
   use model_time_variation, only: time_variation_t, variation_factor, variation_is_constant

@@ -20,7 +20,7 @@
 !> ETOTAL stays continuous.
 module driver_mass_scaling
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_mesh, only: element_cpe4r, element_cax4r
   use model_steps, only: mass_scaling_uniform

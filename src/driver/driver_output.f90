@@ -4,7 +4,7 @@
 module driver_output
   use, intrinsic :: iso_fortran_env, only: int64, output_unit, error_unit
   use mpi_f08, only: MPI_Comm
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_steps, only: field_output_t, history_output_t
   use parallel_partition, only: partition_t, local_node_index
@@ -15,12 +15,11 @@ module driver_output
        field_writer_frame_count
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
   use output_timer, only: clock_text
+  use output_schedule, only: output_schedule_t, field_schedule, history_schedule, schedule_resume
   use fem_corotation, only: stored_to_global
   use driver_stop_condition, only: count_stop_columns, add_stop_columns, stop_column_values
   implicit none
   private
-
-  integer, parameter :: default_history_points = 100
 
   type, public :: run_output_t
      character(len=:), allocatable :: base          !< path without extension
@@ -29,7 +28,8 @@ module driver_output
      logical :: fields_open = .false.
      integer :: n_history_columns = 0
      character(len=32), allocatable :: columns(:)   !< history column names
-     real(dp) :: next_field = 0, next_history = 0   !< step times of the next frame / row
+     !> the running step's frame and row schedules (output_schedule: the rule MPM shares)
+     type(output_schedule_t) :: field_schedule, history_schedule
      real(dp) :: energy_reference = 0               !< ETOTAL at the start (subtracted)
      !> Energy-balance check (write_history): energies below energy_floor are not significant;
      !> energy_peak is the largest max(ALLKE, ALLIE, |ALLWK|) seen so far.
@@ -40,9 +40,8 @@ module driver_output
      logical :: progress = .true.
   end type run_output_t
 
-  public :: open_run_output, close_run_output, step_output_start, output_due, write_frame, &
-       write_history, energy_values, progress_line, field_interval, history_interval, &
-       output_frequency, sum_over_ranks
+  public :: open_run_output, close_run_output, step_output_start, write_frame, &
+       write_history, energy_values, progress_line, sum_over_ranks
 
 contains
 
@@ -144,84 +143,21 @@ contains
     call history_close(out%history)
   end subroutine close_run_output
 
-  real(dp) function field_interval(m, istep)
+  !> At the start of a step (or where a restart continues it, at step time `resume_time`): the
+  !> step's frame and row schedules.
+  subroutine step_output_start(m, istep, out, resume_time)
     type(model_t), intent(in) :: m
     integer, intent(in) :: istep
-    integer :: j
-
-    field_interval = 0
-    if (.not. allocated(m%steps(istep)%field_outputs)) return
-    do j = 1, size(m%steps(istep)%field_outputs)
-       associate (f => m%steps(istep)%field_outputs(j))
-         if (f%time_interval > 0) then
-            field_interval = f%time_interval
-         else if (f%number_interval > 0) then
-            field_interval = m%steps(istep)%period / f%number_interval
-         end if
-       end associate
-    end do
-  end function field_interval
-
-  real(dp) function history_interval(m, istep)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: istep
-    integer :: j
-    logical :: by_time
-
-    history_interval = m%steps(istep)%period / default_history_points
-    if (.not. allocated(m%steps(istep)%history_outputs)) return
-    by_time = size(m%steps(istep)%history_outputs) == 0
-    do j = 1, size(m%steps(istep)%history_outputs)
-       associate (h => m%steps(istep)%history_outputs(j))
-         if (h%time_interval > 0) then
-            history_interval = min(history_interval, h%time_interval)
-         else if (h%number_interval > 0) then
-            history_interval = min(history_interval, m%steps(istep)%period / h%number_interval)
-         end if
-         if (h%frequency == 0) by_time = .true.
-       end associate
-    end do
-    ! Only FREQUENCY= requests: rows by increment count alone.
-    if (.not. by_time) history_interval = 0
-  end function history_interval
-
-  !> The smallest FREQUENCY= (every n increments) of the step's field (`field`) or history
-  !> requests; 0 when none asks for one.
-  integer function output_frequency(m, istep, field)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: istep
-    logical, intent(in) :: field
-    integer :: j
-
-    output_frequency = 0
-    if (field .and. allocated(m%steps(istep)%field_outputs)) then
-       do j = 1, size(m%steps(istep)%field_outputs)
-          call take(m%steps(istep)%field_outputs(j)%frequency)
-       end do
-    else if (.not. field .and. allocated(m%steps(istep)%history_outputs)) then
-       do j = 1, size(m%steps(istep)%history_outputs)
-          call take(m%steps(istep)%history_outputs(j)%frequency)
-       end do
-    end if
-  contains
-    subroutine take(f)
-      integer, intent(in) :: f
-      if (f > 0 .and. (output_frequency == 0 .or. f < output_frequency)) output_frequency = f
-    end subroutine take
-  end function output_frequency
-
-  !> At the start of a step: first frame and row at its start time.
-  subroutine step_output_start(out)
     type(run_output_t), intent(inout) :: out
-    out%next_field = 0
-    out%next_history = 0
-  end subroutine step_output_start
+    real(dp), intent(in), optional :: resume_time
 
-  !> Is the step time at (or, by round-off, just short of) the next output time?
-  pure logical function output_due(step_time, next, period, dt)
-    real(dp), intent(in) :: step_time, next, period, dt
-    output_due = step_time >= next - 1.0e-9_dp * max(period, dt) .or. step_time >= period * (1 - 1.0e-12_dp)
-  end function output_due
+    call field_schedule(m%steps(istep), out%field_schedule)
+    call history_schedule(m%steps(istep), out%history_schedule)
+    if (present(resume_time)) then
+       call schedule_resume(out%field_schedule, resume_time)
+       call schedule_resume(out%history_schedule, resume_time)
+    end if
+  end subroutine step_output_start
 
   !> One field frame with the variables the step asks for.
   subroutine write_frame(m, solver, out, istep)
@@ -231,20 +167,27 @@ contains
     integer, intent(in) :: istep
     integer :: j, k
     type(field_output_t) :: f
+    character(len=8), allocatable :: written(:)
 
     if (.not. out%fields_open .or. .not. allocated(m%steps(istep)%field_outputs)) return
     call field_writer_frame(out%fields, istep, solver%step_time, solver%total_time, solver%increment)
     call field_writer_coordinates(out%fields, solver%part%node_global, solver%part%node_owned, &
          solver%x0 + solver%u)
+    ! every variable once, however many of the step's requests ask for it
+    allocate (written(0))
     do j = 1, size(m%steps(istep)%field_outputs)
        f = m%steps(istep)%field_outputs(j)
        if (allocated(f%node_variables)) then
           do k = 1, size(f%node_variables)
+             if (any(written == f%node_variables(k))) cycle
+             written = [character(len=8) :: written, f%node_variables(k)]
              call write_node_variable(solver, out, trim(f%node_variables(k)))
           end do
        end if
        if (allocated(f%element_variables)) then
           do k = 1, size(f%element_variables)
+             if (any(written == f%element_variables(k))) cycle
+             written = [character(len=8) :: written, f%element_variables(k)]
              call write_element_variable(m, solver, out, trim(f%element_variables(k)))
           end do
        end if

@@ -4,7 +4,7 @@
 !> sees: Δε^p = Δε − C⁻¹(σ_new − σ_old), in the corotational frame like LE, tensor shears.
 !> It is kept (and costs anything) only when a step writes PE (driver_setup).
 module driver_plastic_strain
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

@@ -10,7 +10,7 @@
 !>   f_b = 2π p (−Δz, Δr)(r_a + 2 r_b)/6 (exact for r linear along the edge);
 !> * C3D8R face: f_I = p ∫ N_I (x_ξ × x_η) dξ dη over the bilinear face, 2×2 Gauss (exact).
 module driver_pressure
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_mesh, only: element_cax4r
   use model_surfaces, only: cpe4r_faces, c3d8r_faces

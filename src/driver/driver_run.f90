@@ -5,7 +5,7 @@
 module driver_run
   use, intrinsic :: iso_fortran_env, only: output_unit
   use mpi_f08, only: MPI_Comm
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use model, only: model_t
   use model_mesh, only: element_cpe4r, element_cax4r
@@ -19,8 +19,7 @@ module driver_run
   use driver_loads, only: step_loads_t, prepare_step, apply_prescribed_velocities, &
        apply_rigid_body_velocities, gravity_forces, apply_contact, gravity_varies_in_step
   use driver_output, only: run_output_t, open_run_output, close_run_output, step_output_start, &
-       output_due, write_frame, write_history, energy_values, progress_line, field_interval, &
-       history_interval, output_frequency, sum_over_ranks
+       write_frame, write_history, energy_values, progress_line, sum_over_ranks
   use driver_checkpoint, only: save_checkpoint, load_checkpoint
   use driver_mass_scaling, only: apply_step_mass_scaling
   use driver_pressure, only: step_pressures_t, prepare_pressures, add_pressure_forces
@@ -31,6 +30,7 @@ module driver_run
   use fem_c3d8r, only: c3d8r_char_length
   use fem_stable_dt, only: element_stable_dt
   use output_timer, only: timer_report
+  use output_schedule, only: schedule_due, schedule_advance
   use output_collective, only: stop_agreed_error
   implicit none
   private
@@ -95,8 +95,7 @@ contains
        if (err%raised) call stop_agreed_error(part%comm, err)
        resumed = .true.
        call open_run_output(m, solver, out, opts%output_base, frames, rows, solver%total_time)
-       out%next_field = solver%restart_next_field
-       out%next_history = solver%restart_next_history
+       call step_output_start(m, first_step, out, solver%step_time)
        out%energy_reference = solver%restart_energy_reference
        out%energy_peak = solver%restart_energy_peak
     else
@@ -117,7 +116,7 @@ contains
           solver%step_time = 0
           solver%step_start = solver%total_time
           solver%step_increment = 0
-          call step_output_start(out)
+          call step_output_start(m, istep, out)
           call stop_step_start(solver)
           call apply_step_mass_scaling(m, istep, solver, solver%dt_stable)
           if (istep == 1) then
@@ -542,39 +541,14 @@ contains
     type(run_output_t), intent(inout) :: out
     type(effects_t), intent(inout) :: effects
     integer, intent(in) :: istep
-    real(dp) :: period, interval
-    integer :: frequency
-    logical :: due, step_end
-
-    period = m%steps(istep)%period
     call effects%start(effect_output)
-    ! FREQUENCY=n requests: every n-th increment of the step and the step's end.
-    step_end = solver%step_time >= period * (1 - 1.0e-12_dp)
-    interval = field_interval(m, istep)
-    frequency = output_frequency(m, istep, .true.)
-    due = .false.
-    if (interval > 0) due = output_due(solver%step_time, out%next_field, period, solver%dt)
-    if (frequency > 0) due = due .or. mod(solver%step_increment, frequency) == 0 .or. step_end
-    if (due) then
+    if (schedule_due(out%field_schedule, solver%step_time, solver%step_increment, solver%dt)) then
        call write_frame(m, solver, out, istep)
-       if (interval > 0) then
-          do while (out%next_field <= solver%step_time + 1.0e-9_dp * period)
-             out%next_field = out%next_field + interval
-          end do
-       end if
+       call schedule_advance(out%field_schedule, solver%step_time)
     end if
-    interval = history_interval(m, istep)
-    frequency = output_frequency(m, istep, .false.)
-    due = .false.
-    if (interval > 0) due = output_due(solver%step_time, out%next_history, period, solver%dt)
-    if (frequency > 0) due = due .or. mod(solver%step_increment, frequency) == 0 .or. step_end
-    if (due) then
+    if (schedule_due(out%history_schedule, solver%step_time, solver%step_increment, solver%dt)) then
        call write_history(m, solver, out, istep)
-       if (interval > 0) then
-          do while (out%next_history <= solver%step_time + 1.0e-9_dp * period)
-             out%next_history = out%next_history + interval
-          end do
-       end if
+       call schedule_advance(out%history_schedule, solver%step_time)
     end if
     call effects%stop(effect_output)
   end subroutine write_outputs

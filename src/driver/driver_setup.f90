@@ -2,7 +2,7 @@
 !> partition, reference geometry, lumped masses, material moduli from the packaging call,
 !> initial conditions, and the internal forces of the initial stresses.
 module driver_setup
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_mesh, only: element_cpe4r, element_cax4r
   use parallel_partition, only: partition_t, local_node_index, local_elem_index

@@ -7,7 +7,7 @@
 !> of a block is stored (element, component), so a block's stress is exactly the
 !> `(nblock, ncomp)` array a VUMAT receives: no copies on the way in or out.
 module driver_solver
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_mesh, only: element_c3d8r
   use parallel_partition, only: partition_t
@@ -96,8 +96,8 @@ module driver_solver
      real(dp) :: dt = 0, dt_prev = 0                  !< dt_{n+1/2}, dt_{n-1/2}
      real(dp) :: dt_stable = 0                        !< stable increment at t_n (before scaling)
      integer :: dt_element = 0                        !< user number of the controlling element
-     ! Output schedule carried through a restart (driver_checkpoint -> driver_run).
-     real(dp) :: restart_next_field = 0, restart_next_history = 0, restart_energy_reference = 0
+     ! Energy check carried through a restart (driver_checkpoint -> driver_run).
+     real(dp) :: restart_energy_reference = 0
      real(dp) :: restart_energy_peak = 0
      ! Step stop condition (driver_stop_condition): displacements at the step start, the largest
      ! displacement since then over the condition's node set, the kinetic-energy peak of the

@@ -20,7 +20,7 @@
 !> ordinary sum and may differ from it in the last bits).
 module driver_stop_condition
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use parallel_partition, only: local_node_index
   use parallel_assembly, only: global_max, global_sum_exact

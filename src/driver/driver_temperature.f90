@@ -6,17 +6,16 @@
 !> Elements: the integration point's temperature is the mean of its nodes' temperatures (the
 !> centroid value of the bilinear/trilinear interpolation), written as base + Σ_j coef_j a_j(t)
 !> with base the initial temperatures of the nodes no entry names; the coefficients are built
-!> once per step and block. Particles: all particles of a material share one temperature, the
-!> last entry naming the material, else its initial temperature.
+!> once per step and block. Particles: model_particle_fields.
 module driver_temperature
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_time_variation, only: variation_factor
   use driver_solver, only: solver_t, element_block_t
   implicit none
   private
 
-  public :: element_temperatures, particle_temperature, particle_initial_field
+  public :: element_temperatures
 
 contains
 
@@ -85,40 +84,4 @@ contains
        end do
     end do
   end subroutine build_coefficients
-
-  !> The temperature of the particles of `material` in step `step` at the given times.
-  real(dp) function particle_temperature(m, step, material, step_time, total_time) result(temp)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: step, material
-    real(dp), intent(in) :: step_time, total_time
-    integer :: j
-
-    if (allocated(m%steps(step)%temperatures)) then
-       do j = size(m%steps(step)%temperatures), 1, -1
-          associate (t => m%steps(step)%temperatures(j))
-            if (t%material /= material) cycle
-            temp = t%value * variation_factor(t%variation, m%amplitudes, step_time, total_time)
-            return
-          end associate
-       end do
-    end if
-    temp = particle_initial_field(m, material, 0)
-  end function particle_temperature
-
-  !> *INITIAL CONDITIONS of the particles of `material`: field `variable` (0: temperature); the
-  !> last entry naming the material counts, 0 without one.
-  real(dp) function particle_initial_field(m, material, variable) result(value)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: material, variable
-    integer :: j
-
-    value = 0
-    if (.not. allocated(m%initial_fields)) return
-    do j = size(m%initial_fields), 1, -1
-       if (m%initial_fields(j)%material == material .and. m%initial_fields(j)%variable == variable) then
-          value = m%initial_fields(j)%value
-          return
-       end if
-    end do
-  end function particle_initial_field
 end module driver_temperature

@@ -13,7 +13,7 @@
 !> highest mode, which reduces the stable increment (fem_stable_dt).
 !> Its work, σ_bv tr Δε V = ρ c_d L_e ξ ε̇_v² Δt V ≥ 0, is dissipated (ALLVD).
 module fem_bulk_viscosity
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

@@ -18,7 +18,7 @@
 !> The a_k (k ≥ 1) involve only coordinate differences, so large absolute coordinates cost no
 !> digits. B is exact: Σ_I x_jI B_iI = δ_ij and Σ_I B_iI = 0 (patch test).
 module fem_c3d8r
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use fem_hourglass, only: hourglass_forces
   implicit none
   private

@@ -21,7 +21,7 @@
 !> (docs/theory/elements.md §3.10).
 !> Components (nb, 4): 11 = rr, 22 = zz, 33 = θθ, 12 = rz (tensor shear), as Abaqus passes them.
 module fem_cax4r
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use fem_hourglass, only: hourglass_viscous, hourglass_stiffness
   use fem_plane_frame, only: plane_corotational_step
   use fem_inversion, only: inversion_none, inversion_centre, inversion_corner, inversion_collapse, &

@@ -13,7 +13,7 @@
 !>   spin vectors  (nb, nshr)         2D: ω3 = W21; 3D: (ω1, ω2, ω3) = (W32, W13, W21)
 !> Plane strain (ndim 2): R is an in-plane rotation, R33 = 1, and the 33 component is untouched.
 module fem_corotation
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use fem_plane_frame, only: plane_defgrad, plane_rotation, plane_similarity, plane_relative_spin
   implicit none
   private

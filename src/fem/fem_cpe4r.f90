@@ -13,7 +13,7 @@
 !> B is the exact mean gradient, so Σ_I x_jI B_iI = δ_ij, Σ_I B_iI = 0: linear fields give
 !> exactly uniform strain and uniform stress gives self-equilibrated interior forces.
 module fem_cpe4r
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use fem_hourglass, only: hourglass_viscous, hourglass_stiffness
   use fem_plane_frame, only: plane_corotational_step
   use fem_inversion, only: inversion_none, inversion_centre, inversion_corner, inversion_collapse

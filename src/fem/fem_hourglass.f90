@@ -18,7 +18,7 @@
 !> Storing the stiffness force in the corotational frame keeps it objective: a rigid rotation
 !> turns the hourglass force with the element and does no work.
 module fem_hourglass
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   ! The codes are the model's (a section owns its hourglass control); re-exported for the kernels' callers.
   use model_materials, only: hourglass_none, hourglass_viscous, hourglass_stiffness, &
        default_hourglass_viscous_coefficient, default_hourglass_stiffness_coefficient

@@ -10,7 +10,7 @@
 !> Node numbering: CPE4R 1–4 counter-clockwise; C3D8R 1–4 bottom face, counter-clockwise seen
 !> from the top, 5–8 above them (Abaqus order).
 module fem_inversion
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

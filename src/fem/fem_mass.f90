@@ -4,7 +4,7 @@
 !> and volume (mass is conserved in a Lagrangian mesh). In plane strain V = A·t, so the
 !> element mass is ρ A t.
 module fem_mass
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

@@ -8,7 +8,7 @@
 !> starts from 0 and runs in the order of the general nd loops of fem_corotation, so every caller
 !> gets the same result to the bit.
 module fem_plane_frame
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

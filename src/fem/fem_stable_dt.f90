@@ -6,7 +6,7 @@
 !> p-wave modulus the driver gets from the material's packaging call, ρ the current density.
 !> The driver takes scale · min_e Δt_e over all ranks.
 module fem_stable_dt
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

@@ -11,7 +11,7 @@ module keyword_numbers
   use, intrinsic :: iso_c_binding, only: c_char, c_double, c_null_char, c_ptr, c_null_ptr
   use, intrinsic :: iso_fortran_env, only: int64
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

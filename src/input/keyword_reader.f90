@@ -24,7 +24,7 @@
 !> the line, kept in one growing array per file — no allocation per line or per field. The
 !> buffers live as long as the program (a deck is read once).
 module keyword_reader
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error, pass_error
   use keyword_numbers, only: upper_case, is_real_text, is_integer_text, text_to_real, &
        text_to_integer, is_integer_syntax, int_text, real_text, normalize_name

@@ -3,7 +3,7 @@
 !> model%amplitudes. An amplitude may be defined in model data or inside a step; its name
 !> is global either way, so every amplitude is known before steps refer to them.
 module scene_amplitudes
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t
   use model, only: model_t

@@ -15,7 +15,7 @@
 !>   translation and rotation (scene_instance_map).
 !> Blocks keep the file:line where they were written, so errors point at the part.
 module scene_assembly
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, upper_case, is_integer_text
   use scene_util, only: itoa, where_text, field_blank, push_block

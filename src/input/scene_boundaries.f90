@@ -9,7 +9,7 @@
 !> Abaqus's shorthands XSYMM (dof 1), YSYMM (2), ZSYMM (3), PINNED and ENCASTRE (all
 !> translations; our continuum nodes have no rotations).
 module scene_boundaries
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_block_t, data_line_t, is_integer_syntax
   use model, only: model_t

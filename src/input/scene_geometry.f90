@@ -9,7 +9,7 @@
 !> edge, well below any mesh a solver can integrate.
 module scene_geometry
   use, intrinsic :: iso_fortran_env, only: int64
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t
   use model, only: model_t

@@ -10,7 +10,7 @@
 !> tempOld/tempNew until a step's *TEMPERATURE changes it). In material-point scenes only FIELD
 !> and TEMPERATURE, on the particles of a material (`material name, value`).
 module scene_initial
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t
   use model, only: model_t, initial_velocity_t, initial_stress_t, initial_field_t

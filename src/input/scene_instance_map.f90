@@ -8,7 +8,7 @@
 !> the axis through points a and b (right-hand rule about a -> b); the translation is applied
 !> first, then the rotation.
 module scene_instance_map
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_block_t, data_line_t, upper_case, is_integer_text, is_real_text, &
     set_field

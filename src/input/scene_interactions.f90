@@ -1,7 +1,7 @@
 !> *SURFACE INTERACTION, NAME=... with its *FRICTION (Coulomb coefficient mu) ->
 !> model%interactions. Without *FRICTION the interaction is frictionless (Abaqus's default).
 module scene_interactions
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t
   use model, only: model_t

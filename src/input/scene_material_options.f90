@@ -6,7 +6,7 @@
 !> what our VUMATs cannot represent (temperature dependence, hardening of Drucker-Prager,
 !> K /= 1, ...) is an error naming what was expected instead of being silently dropped.
 module scene_material_options
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t
   use model_sets, only: name_length

@@ -6,7 +6,7 @@
 !> After translation the props go through the same decoder the VUMAT uses (material_props),
 !> so a scene that passes here cannot be rejected by the material on its first call.
 module scene_materials
-  use material_kinds, only: dp, deg_to_rad
+  use base_kinds, only: dp, deg_to_rad
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t
   use model, only: model_t

@@ -7,7 +7,7 @@
 !> strain) or C3D8R (3D); the type fixes ndim. In 2D a node may carry a third coordinate
 !> only if it is zero (files written for 3D post-processors often do that).
 module scene_mesh
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t
   use model, only: model_t

@@ -15,7 +15,7 @@
 !> "Up" is +y (axis 2) in 2D and 3D. The checks end with `file:line: what; expected ...`.
 module scene_mpm
   use, intrinsic :: iso_fortran_env, only: int64
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t
   use model, only: model_t

@@ -10,7 +10,7 @@
 !> RF, S, LE, PE, PEEQ, STATUS (field) or the energies (history); VARIABLE=ALL for every
 !> field variable we have (adds SDV) or the energies.
 module scene_outputs
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_block_t, data_line_t
   use model, only: model_t

@@ -4,7 +4,7 @@
 !> (the rule of *DLOAD: on one *DSLOAD of a step, on all of them). Loads carry over to later
 !> steps like gravity (model_time_variation).
 module scene_pressure
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_block_t
   use model, only: model_t

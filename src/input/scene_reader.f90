@@ -86,7 +86,6 @@ contains
        if (err%raised) return
        call count_user_fields(model)
        call build_steps(deck, layout, model, err)
-       if (.not. err%raised) call refuse_frequency(deck, err)
        return
     end if
     call build_mesh(deck, layout, model, sources, err)
@@ -112,20 +111,6 @@ contains
     call count_user_fields(model)
     call build_steps(deck, layout, model, err)
   end subroutine read_scene
-
-  !> The MPM run writes output by time only.
-  subroutine refuse_frequency(deck, err)
-    type(keyword_deck_t), intent(in) :: deck
-    type(error_t), intent(inout) :: err
-    integer :: i
-
-    do i = 1, deck%n_blocks
-       if (deck%blocks(i)%name /= 'OUTPUT' .or. .not. deck%blocks(i)%has_param('FREQUENCY')) cycle
-       call deck%blocks(i)%fail('*OUTPUT, FREQUENCY= in a material-point scene; expected NUMBER INTERVAL=n ' // &
-            'or TIME INTERVAL=t (the MPM run writes output by time)', err)
-       return
-    end do
-  end subroutine refuse_frequency
 
   !> A user's VUMAT or VUSDFLD receives every field variable the scene defines (nfieldv = the
   !> highest VARIABLE= of *INITIAL CONDITIONS, TYPE=FIELD, or FIELDS= of *USER DEFINED FIELD if

@@ -9,7 +9,7 @@
 !> is that factor times our default for the form (model_materials). Abaqus's other forms
 !> (RELAX STIFFNESS, ENHANCED, COMBINED) and scale factors are not supported.
 module scene_sections
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t
   use model, only: model_t

@@ -5,7 +5,7 @@
 !> meant in a hopper (the fill springs up when gravity falls at the outlet's opening), so the
 !> scene builder names the *DLOAD line and says what to write instead. The run goes on.
 module scene_step_continuity
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_steps, only: gravity_t
   use model_time_variation, only: variation_factor

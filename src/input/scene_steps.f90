@@ -18,7 +18,7 @@
 !>
 !> Model-data *BOUNDARY (zero displacements) and *CONTACT PAIR start the chain.
 module scene_steps
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_syntax
   use model, only: model_t

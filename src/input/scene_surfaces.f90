@@ -10,7 +10,7 @@
 !>
 !> Element and rigid surfaces share one namespace, as in Abaqus.
 module scene_surfaces
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, is_integer_text
   use model, only: model_t

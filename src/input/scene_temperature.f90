@@ -10,7 +10,7 @@
 !> (the nodes return to their initial temperatures). Abaqus Analysis User's Guide, "Predefined
 !> fields" and "Amplitude curves".
 module scene_temperature
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_block_t, data_line_t
   use model, only: model_t

@@ -8,7 +8,7 @@
 !> scene reader must never crash. We therefore reject any number whose decimal exponent
 !> puts it at or beyond `max_magnitude` before Fortran's read sees it.
 module scene_util
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: data_line_t, keyword_block_t, upper_case, is_real_text
   use keyword_numbers, only: written_exponent

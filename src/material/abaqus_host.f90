@@ -13,7 +13,7 @@
 !> `host_set_exit_handler` lets the application decide how `xplb_exit` ends the run (plain
 !> exit, or MPI_Abort in the parallel solver).
 module abaqus_host
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

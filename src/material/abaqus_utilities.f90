@@ -12,7 +12,7 @@
 !> returns jStatus /= 0, but user code that does not test it would go on with stale data.
 subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
   use, intrinsic :: iso_fortran_env, only: error_unit
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use abaqus_host, only: host_get_variable, host_available_keys, host_exit
   implicit none
   character(len=*), intent(in) :: cVar
@@ -36,7 +36,7 @@ end subroutine vgetvrm
 !> %I, %R and %S in the text are replaced by successive entries of intv, realv and charv.
 subroutine xplb_abqerr(lop, string, intv, realv, charv)
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use abaqus_host, only: host_exit
   implicit none
   integer, intent(in) :: lop

@@ -20,7 +20,7 @@
 !> and logarithmic strain available to vgetvrm; its fields become the vumat's fieldNew and its
 !> state the vumat's stateOld.
 module material_door
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use abaqus_host, only: host_set_block, host_set_block_extra, host_set_block_moduli
   use model_materials, only: material_t

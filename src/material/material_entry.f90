@@ -49,7 +49,7 @@ subroutine bulkflow_vumat(nblock, ndir, nshr, nstatev, nfieldv, nprops, lanneal,
      dt, cmname, coordMp, charLength, props, density, strainInc, relSpinInc, tempOld, stretchOld, &
      defgradOld, fieldOld, stressOld, stateOld, enerInternOld, enerInelasOld, tempNew, stretchNew, &
      defgradNew, fieldNew, stressNew, stateNew, enerInternNew, enerInelasNew)
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   integer, intent(in) :: nblock(*), ndir, nshr, nstatev, nfieldv, nprops, lanneal
   real(dp), intent(in) :: stepTime, totalTime, dt

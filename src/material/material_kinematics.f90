@@ -8,7 +8,7 @@
 !> (strain increments without spin), which is what the closed-form checks assume. Our VUMATs do
 !> not use U or F; user VUMATs that do get a consistent, symmetric pair.
 module material_kinematics
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use lapack_interfaces, only: dsyev
   implicit none
   private

@@ -6,7 +6,7 @@
 !> and F from the logarithmic strain (material_kinematics), the current density ρ0 exp(−tr ε)
 !> at mid-increment, the input's temperature as tempOld and tempNew.
 module matpoint_block
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_materials, only: material_t
   use material_door, only: vumat_work_t, vumat_work_init, call_material
   use material_kinematics, only: stretch_from_log_strain, defgrad_from_stretch

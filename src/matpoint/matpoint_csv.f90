@@ -18,7 +18,7 @@
 !>   FV1 ...          field variables used in the increment (with *USER DEFINED FIELD)
 !>   ener_intern ener_inelas    specific internal / inelastic energy (per unit mass)
 module matpoint_csv
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use model_materials, only: material_t
   use material_props, only: model_from_name, model_mohr_coulomb, model_drucker_prager

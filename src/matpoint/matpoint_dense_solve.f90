@@ -3,7 +3,7 @@
 !> matrix marks it singular (dgesv itself only reports an exact zero), so the caller can fall
 !> back to the elastic stiffness instead of producing Inf/NaN.
 module matpoint_dense_solve
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use lapack_interfaces, only: dgesv
   implicit none
   private

@@ -18,7 +18,7 @@
 !>   *STAGE, INC=n [, TIME=t] [, STRAIN=x] [, STRESS=s]   (GENERAL: data "comp, STRAIN|STRESS|HOLD, value")
 !>   *DRIVER CONTROLS [, TOLERANCE=tol] [, ITERATIONS=n]
 module matpoint_input
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, read_keyword_file, &
        read_keyword_string, upper_case

@@ -11,7 +11,7 @@
 !> vertical/axial direction is `axis` (default 2, i.e. y, as in our plane-strain models
 !> whose out-of-plane direction is 3). Stresses are in the Abaqus sign (tension positive).
 module matpoint_path
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

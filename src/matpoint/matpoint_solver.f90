@@ -19,7 +19,7 @@
 !> path is one Abaqus step: stepTime = totalTime = time at the END of the increment (so
 !> the first increment is never mistaken for the packaging call, which has time 0).
 module matpoint_solver
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use model_materials, only: material_t
   use matpoint_path, only: matpoint_path_t, matpoint_stage_t, control_strain, control_stress, &

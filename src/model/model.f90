@@ -2,7 +2,7 @@
 !> first increment (nothing is read or resolved later): mesh, sets, surfaces, materials,
 !> sections, amplitudes, interactions, initial conditions and steps.
 module model
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_mesh, only: mesh_t
   use model_sets, only: index_set_t, name_length
   use model_surfaces, only: element_surface_t, rigid_surface_t

@@ -2,7 +2,7 @@
 !> smooth step (Abaqus: a = A_i + (A_i+1 - A_i) ξ³(10 - 15ξ + 6ξ²) between data points),
 !> over step time or total time.
 module model_amplitudes
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_sets, only: name_length
   implicit none
   private

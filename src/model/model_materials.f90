@@ -3,7 +3,7 @@
 !> builder into the name and props of our own VUMATs (umat/README.md); *USER MATERIAL keeps
 !> the user's name and constants.
 module model_materials
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_sets, only: name_length
   implicit none
   private

@@ -2,7 +2,7 @@
 !> type per model (CPE4R in 2D plane strain, C3D8R in 3D), connectivity by internal index,
 !> and the user's node and element numbers for messages and output.
 module model_mesh
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_sets, only: sorted_position
   implicit none
   private

@@ -4,7 +4,7 @@
 !> a carried condition's time variation follows model_time_variation), so each step_t holds
 !> its complete active set and the driver never looks back.
 module model_steps
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_sets, only: name_length
   use model_time_variation, only: time_variation_t
   implicit none

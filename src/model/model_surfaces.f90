@@ -1,7 +1,7 @@
 !> Surfaces: element-face surfaces of the deformable mesh (the nodes that touch walls) and
 !> analytic rigid surfaces (walls) that move with a reference node.
 module model_surfaces
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_sets, only: name_length
   implicit none
   private

@@ -13,7 +13,7 @@
 !> The scene builder applies the carry rule at each step start (carry_into_step); the element
 !> driver and the MPM evaluate the factor with variation_factor and nothing else.
 module model_time_variation
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model_amplitudes, only: amplitude_t
   implicit none
   private

@@ -3,7 +3,7 @@
 !> each step. Filled and checked by src/input/scene_mpm.f90; read by src/mpm/mpm_run.f90.
 !> Only data here: the model keeps one `mpm_scene_t`, inactive unless the scene has *MPM GRID.
 module mpm_scene
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

@@ -8,7 +8,7 @@
 !>     (output_checkpoint agrees on errors), and the ranks hold different numbers of blocks;
 !>   * the run's counters and sums (mpm_saved_t): time, step, increment, Δt, particle
 !>     numbering, mass and particle counts in/out, energies, wall impulses and forces, the
-!>     step's output schedule, the MDR reference of the last history row, and the number of
+!>     step's increment count (the output schedule is rebuilt from it and the step time), the MDR reference of the last history row, and the number of
 !>     field frames and history rows written so far;
 !>   * the scene's digest (model_digest: a hash per keyword and data line), so that a restart
 !>     of an edited scene is refused at the first line that differs (file:line).
@@ -27,7 +27,7 @@
 !> `bulkflow: error: file: what is wrong; expected ...`, exit status 2, no MPI_Abort.
 module mpm_checkpoint
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Bcast, MPI_INTEGER
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error, add_expectation
   use model, only: model_t
   use checkpoint_scene, only: put_scene_digest, check_saved_scene
@@ -57,7 +57,9 @@ module mpm_checkpoint
      real(dp), allocatable :: wall_force(:, :)        !< (3, n_walls)
      real(dp), allocatable :: wall_impulse(:, :)      !< (3, n_walls) since the last history row
      real(dp), allocatable :: wall_force_row(:, :)    !< (3, n_walls) of the last history row
-     real(dp) :: next_field = 0, next_history = 0     !< the step's output schedule
+     !> increments of the running step: the FREQUENCY= output requests count them (the
+     !> requests' next times are rebuilt from the step time, output_schedule)
+     integer :: step_increment = 0
      real(dp) :: last_row_time = 0, last_row_out = 0  !< time and MASS_OUT of the last row (MDR)
      integer :: frames = 0                            !< field frames written (rank 0's writer)
      integer :: rows = 0                              !< history rows written
@@ -65,8 +67,8 @@ module mpm_checkpoint
 
   public :: mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
 
-  integer, parameter :: n_scalars = 20
-  integer, parameter :: n_counters = 6
+  integer, parameter :: n_scalars = 18
+  integer, parameter :: n_counters = 7
   !> The per-particle real arrays of a block that a checkpoint holds (the stencil arrays node,
   !> w, dw are recomputed at the start of every increment).
   character(len=13), parameter :: block_fields(13) = [character(len=13) :: 'x', 'v', 'mass', 'vol0', 'f', &
@@ -120,7 +122,8 @@ contains
     header%history_rows = sv%rows
     call checkpoint_begin_write(ck, base, comm, header)
     call put_scene_digest(ck, m%digest)
-    call checkpoint_put(ck, 'counters', [sv%next_number, sv%n_initial, sv%n_in, sv%n_out, sv%n_guarded, nblocks])
+    call checkpoint_put(ck, 'counters', [sv%next_number, sv%n_initial, sv%n_in, sv%n_out, sv%n_guarded, nblocks, &
+         sv%step_increment])
     call checkpoint_put(ck, 'scalars', pack_scalars(sv))
     call checkpoint_put(ck, 'wall_force', sv%wall_force)
     call checkpoint_put(ck, 'wall_impulse', sv%wall_impulse)
@@ -199,6 +202,7 @@ contains
     sv%n_out = counters(4)
     sv%n_guarded = counters(5)
     nblocks = counters(6)
+    sv%step_increment = counters(7)
 
     ! The block table, checked before anything is allocated from it (a damaged file must not
     ! make this rank allocate nonsense while the others wait).
@@ -427,7 +431,7 @@ contains
 
     r = [sv%dt_stable, sv%mass_initial, sv%mass_in, sv%mass_out, sv%mass_cutoff, sv%e_kinetic, &
          sv%e_internal, sv%w_external, sv%e_walls, sv%e_damping, sv%e_out, sv%e_in, sv%gravity, &
-         sv%impulse_time, sv%next_field, sv%next_history, sv%last_row_time, sv%last_row_out]
+         sv%impulse_time, sv%last_row_time, sv%last_row_out]
   end function pack_scalars
 
   !> The inverse of pack_scalars (time, step time and Δt are in the header).
@@ -449,10 +453,8 @@ contains
     sv%e_in = r(12)
     sv%gravity = r(13:15)
     sv%impulse_time = r(16)
-    sv%next_field = r(17)
-    sv%next_history = r(18)
-    sv%last_row_time = r(19)
-    sv%last_row_out = r(20)
+    sv%last_row_time = r(17)
+    sv%last_row_out = r(18)
   end subroutine unpack_scalars
 
 end module mpm_checkpoint

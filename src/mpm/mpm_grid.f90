@@ -1,7 +1,7 @@
 !> The structured background grid: node arrays reset every increment (the grid carries no
 !> history). Node (i, j[, k]) (0-based) has index 1 + i + n1 (j + n2 k) and position lo + (i, j, k) h.
 module mpm_grid
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

@@ -16,7 +16,7 @@
 !> wall forces and the damping energy, and the plane's reaction is the momentum the fold hands the
 !> real material, −Σ [m_own (p + Δt f)/m − (p_own + Δt f_own)] / Δt.
 module mpm_mirror
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use mpm_scene, only: mpm_wall_t, wall_symmetry
   use mpm_grid, only: grid_t, grid_node_index
   use mpm_walls, only: wall_contains, node_on_wall_tolerance

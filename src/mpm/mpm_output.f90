@@ -21,7 +21,7 @@
 module mpm_output
   use, intrinsic :: iso_fortran_env, only: int32
   use hdf5
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use output_files, only: file_exists, int_to_str
   use output_hdf5, only: frame_sequence

@@ -7,7 +7,7 @@
 !> nblock); removing (outflow) or adding (inflow) particles repacks the block's arrays. That
 !> costs O(block) per change and happens for a few blocks per increment at most.
 module mpm_particles
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

@@ -19,7 +19,7 @@
 !> particle, written every increment and read by four kernels); the factors are 2.4× less data
 !> and the kernels' few multiplications replace the loads.
 module mpm_shape
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use mpm_scene, only: shape_linear
   implicit none
   private

@@ -11,7 +11,7 @@
 !> Particles that end an increment behind a wall (the wall's stencil is one cell wide) are put
 !> back onto it: `guard_particles`; the count is reported.
 module mpm_walls
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use mpm_scene, only: mpm_wall_t, wall_symmetry
   use mpm_grid, only: grid_t
   implicit none

@@ -24,7 +24,7 @@ module output_checkpoint
   use, intrinsic :: iso_fortran_env, only: int32, int64
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_IN_PLACE, &
        MPI_INTEGER, MPI_MAX
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error, add_expectation
   use output_files, only: rename_file, delete_file, int_to_str
   use output_collective, only: agree_on_error

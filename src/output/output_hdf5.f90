@@ -35,7 +35,7 @@ module output_hdf5
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Bcast, &
        MPI_IN_PLACE, MPI_INTEGER, MPI_LOGICAL, MPI_MAX, MPI_SUM, MPI_INFO_NULL
   use hdf5
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use model_mesh, only: element_cpe4r, element_c3d8r, element_cax4r
   use output_files, only: base_name, int_to_str, file_exists

@@ -16,7 +16,7 @@
 !> the file; errors found on open are shared with all ranks.
 module output_history
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Bcast, MPI_INTEGER
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use output_files, only: rename_file, file_exists, int_to_str
   use output_collective, only: agree_on_error

@@ -18,7 +18,7 @@ module output_timer
   use, intrinsic :: iso_fortran_env, only: int64
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_IN_PLACE, &
        MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_MAX, MPI_MIN, MPI_SUM
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: raise_error
   implicit none
   private

@@ -18,7 +18,7 @@
 !> The file is rewritten as a whole after every frame (to a temporary file renamed over the
 !> old one), so it always describes exactly the frames completed so far.
 module output_xdmf
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use output_files, only: rename_file, int_to_str
   implicit none
   private

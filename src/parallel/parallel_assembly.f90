@@ -13,7 +13,7 @@
 module parallel_assembly
   use mpi_f08, only: MPI_Request, MPI_Isend, MPI_Irecv, MPI_Waitall, MPI_STATUSES_IGNORE, &
        MPI_DOUBLE_PRECISION, MPI_F_sync_reg
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: raise_error
   use parallel_comm, only: comm_min, comm_max, comm_sum, comm_sum_exact
   use parallel_partition, only: partition_t

@@ -6,6 +6,8 @@
 !> * `comm_min`, `comm_max`, `comm_sum`: in-place all-reductions of integers and real(dp)
 !>   scalars and arrays (every rank ends with the result)
 !> * `comm_bcast`: integers, reals, logicals, strings from a root rank
+!> * `comm_max_owner`: element-wise maximum over the ranks and the lowest rank that holds it
+!> * `comm_send`, `comm_recv`: blocking point-to-point transfer of integer and real(dp) arrays
 !> * `comm_sum_exact`: an all-reduced sum of real(dp) values that is EXACT before one final
 !>   rounding, hence identical whatever the number of ranks and however the values are spread
 !>   over them (a plain MPI_SUM depends on both)
@@ -15,9 +17,10 @@
 module parallel_comm
   use, intrinsic :: iso_fortran_env, only: int64
   use mpi_f08, only: MPI_Comm, MPI_Datatype, MPI_Op, MPI_Comm_rank, MPI_Comm_size, MPI_Barrier, &
-       MPI_Allreduce, MPI_Bcast, MPI_IN_PLACE, MPI_MIN, MPI_MAX, MPI_SUM, MPI_LOR, &
-       MPI_INTEGER, MPI_INTEGER8, MPI_DOUBLE_PRECISION, MPI_LOGICAL, MPI_CHARACTER
-  use material_kinds, only: dp
+       MPI_Allreduce, MPI_Bcast, MPI_IN_PLACE, MPI_MIN, MPI_MAX, MPI_SUM, MPI_LOR, MPI_MAXLOC, &
+       MPI_INTEGER, MPI_INTEGER8, MPI_DOUBLE_PRECISION, MPI_2DOUBLE_PRECISION, MPI_LOGICAL, MPI_CHARACTER, &
+       MPI_Send, MPI_Recv, MPI_STATUS_IGNORE
+  use base_kinds, only: dp
   implicit none
   private
 
@@ -25,6 +28,22 @@ module parallel_comm
   public :: comm_min, comm_max, comm_sum, comm_any
   public :: comm_bcast
   public :: comm_sum_exact
+  public :: comm_max_owner, comm_send, comm_recv
+
+  !> True on every rank where the flag is true on at least one rank (arrays: element by element).
+  interface comm_any
+     module procedure any_scalar, any_array
+  end interface comm_any
+
+  !> Blocking send of an integer or real(dp) array to rank `dest` with message tag `tag`.
+  interface comm_send
+     module procedure send_int_array, send_real_array
+  end interface comm_send
+
+  !> Blocking receive of an integer or real(dp) array (its whole size) from rank `source`.
+  interface comm_recv
+     module procedure recv_int_array, recv_real_array
+  end interface comm_recv
 
   !> In-place global minimum over the ranks of `comm` (arrays: element by element).
   interface comm_min
@@ -39,7 +58,7 @@ module parallel_comm
   !> In-place global sum. Real sums are NOT reproducible across rank counts (MPI's reduction
   !> order depends on the number of ranks); use comm_sum_exact where that matters.
   interface comm_sum
-     module procedure sum_int, sum_int_array, sum_real, sum_real_array
+     module procedure sum_int, sum_int_array, sum_real, sum_real_array, sum_real_matrix
   end interface comm_sum
 
   !> Broadcast from `root` (in place).
@@ -85,11 +104,68 @@ contains
   end subroutine comm_barrier
 
   !> True on every rank when `flag` is true on at least one (e.g. "some rank failed").
-  subroutine comm_any(comm, flag)
+  subroutine any_scalar(comm, flag)
     type(MPI_Comm), intent(in) :: comm   !< communicator
     logical, intent(inout) :: flag       !< local flag in, global OR out
     call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_LOGICAL, MPI_LOR, comm)
-  end subroutine comm_any
+  end subroutine any_scalar
+
+  subroutine any_array(comm, flags)
+    type(MPI_Comm), intent(in) :: comm
+    logical, contiguous, intent(inout) :: flags(:)
+    call MPI_Allreduce(MPI_IN_PLACE, flags, size(flags), MPI_LOGICAL, MPI_LOR, comm)
+  end subroutine any_array
+
+  !> values(i) ← its maximum over the ranks, owner(i) ← the lowest rank holding that maximum
+  !> (MPI_MAXLOC; ties go to the lower rank, so exactly one rank is the owner). Collective.
+  subroutine comm_max_owner(comm, values, owner)
+    type(MPI_Comm), intent(in) :: comm
+    real(dp), intent(inout) :: values(:)
+    integer, intent(out) :: owner(:)     !< size(values)
+    real(dp) :: pair(2, size(values))
+    integer :: i, rank
+
+    call MPI_Comm_rank(comm, rank)
+    do i = 1, size(values)
+       pair(1, i) = values(i)
+       pair(2, i) = real(rank, dp)
+    end do
+    call MPI_Allreduce(MPI_IN_PLACE, pair, size(values), MPI_2DOUBLE_PRECISION, MPI_MAXLOC, comm)
+    do i = 1, size(values)
+       values(i) = pair(1, i)
+       owner(i) = nint(pair(2, i))
+    end do
+  end subroutine comm_max_owner
+
+  ! --- point to point -------------------------------------------------------------------------
+
+  subroutine send_int_array(comm, x, dest, tag)
+    type(MPI_Comm), intent(in) :: comm
+    integer, contiguous, intent(in) :: x(:)
+    integer, intent(in) :: dest, tag
+    call MPI_Send(x, size(x), MPI_INTEGER, dest, tag, comm)
+  end subroutine send_int_array
+
+  subroutine send_real_array(comm, x, dest, tag)
+    type(MPI_Comm), intent(in) :: comm
+    real(dp), contiguous, intent(in) :: x(:)
+    integer, intent(in) :: dest, tag
+    call MPI_Send(x, size(x), MPI_DOUBLE_PRECISION, dest, tag, comm)
+  end subroutine send_real_array
+
+  subroutine recv_int_array(comm, x, source, tag)
+    type(MPI_Comm), intent(in) :: comm
+    integer, contiguous, intent(inout) :: x(:)
+    integer, intent(in) :: source, tag
+    call MPI_Recv(x, size(x), MPI_INTEGER, source, tag, comm, MPI_STATUS_IGNORE)
+  end subroutine recv_int_array
+
+  subroutine recv_real_array(comm, x, source, tag)
+    type(MPI_Comm), intent(in) :: comm
+    real(dp), contiguous, intent(inout) :: x(:)
+    integer, intent(in) :: source, tag
+    call MPI_Recv(x, size(x), MPI_DOUBLE_PRECISION, source, tag, comm, MPI_STATUS_IGNORE)
+  end subroutine recv_real_array
 
   ! --- reductions ------------------------------------------------------------------------------
 
@@ -164,6 +240,12 @@ contains
     real(dp), contiguous, intent(inout) :: x(:)
     call MPI_Allreduce(MPI_IN_PLACE, x, size(x), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
   end subroutine sum_real_array
+
+  subroutine sum_real_matrix(comm, x)
+    type(MPI_Comm), intent(in) :: comm
+    real(dp), contiguous, intent(inout) :: x(:, :)
+    call MPI_Allreduce(MPI_IN_PLACE, x, size(x), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+  end subroutine sum_real_matrix
 
   ! --- broadcasts ------------------------------------------------------------------------------
 

@@ -18,7 +18,7 @@
 module parallel_partition
   use, intrinsic :: iso_fortran_env, only: int64
   use mpi_f08, only: MPI_Comm
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use model, only: model_t
   use model_mesh, only: mesh_t
   use model_sets, only: sorted_position

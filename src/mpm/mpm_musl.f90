@@ -1,0 +1,284 @@
+!> The transfer phase of an MPM increment (MUSL with a PIC/FLIP blend; docs/theory/mpm.md §4.1):
+!> the stable increment, the step's gravity, stencils, P2G (summed over the ranks), the
+!> mirrored symmetry planes, the grid update with local damping, the walls on v^{n+1}, G2P and
+!> the MUSL remap (summed over the ranks) with the walls again. What it leaves: particles at
+!> x^{n+1} with v^{n+1}, the grid's v_new the remapped velocity the stress update takes its
+!> gradient from.
+module mpm_musl
+  use base_kinds, only: dp
+  use error_report, only: raise_error
+  use model, only: model_t
+  use model_time_variation, only: variation_factor
+  use mpm_state, only: mpm_state_t, mpm_effects_t, fx_p2g, fx_grid, fx_g2p, fx_walls, max_over_ranks, det_f
+  use mpm_grid, only: grid_reset_sums, grid_clear
+  use mpm_particles, only: particle_block_t
+  use mpm_shape, only: block_stencil
+  use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum
+  use mpm_walls, only: wall_project
+  use mpm_mirror, only: mirror_fold, mirror_fold_momentum
+  use output_timer, only: timer_start, timer_stop
+  use parallel_comm, only: comm_sum
+  implicit none
+  private
+
+  public :: stable_increment, block_max_speed, step_gravity, musl_transfer
+  public :: stencil, p2g, grid_update, g2p, remap_velocity
+
+contains
+
+  !> st%dt_stable = cfl·h / max_p(c_p + |v_p|) over all ranks' particles.
+  subroutine stable_increment(st, cfl, cell)
+    type(mpm_state_t), intent(inout) :: st
+    real(dp), intent(in) :: cfl, cell
+    real(dp) :: vmax, v1(1)
+    integer :: ib
+
+    vmax = 0
+    do ib = 1, st%nblocks
+       associate (b => st%blocks(ib))
+         call block_max_speed(b%count, st%nd, st%modulus(b%material), b%mass, b%vol0, b%f, b%v, vmax)
+       end associate
+    end do
+    v1(1) = vmax
+    call max_over_ranks(st, v1)
+    st%dt_stable = cfl * cell / max(v1(1), tiny(1.0_dp))
+  end subroutine stable_increment
+
+  !> vmax ← max(vmax, c_p + |v_p|) over the particles of a block, in order; c_p from the current
+  !> density m/(V0 det F). Explicit-shape dummies, as the other per-block loops (on the block's
+  !> allocatable components every access goes through the descriptor).
+  pure subroutine block_max_speed(nb, nd, modulus, mass, vol0, f, v, vmax)
+    integer, intent(in) :: nb, nd
+    real(dp), intent(in) :: modulus, mass(nb), vol0(nb), f(nb, nd, nd), v(nb, nd)
+    real(dp), intent(inout) :: vmax
+    real(dp) :: speed, rho, detf
+    integer :: p
+
+    do p = 1, nb
+       detf = det_f(f, p, nd)
+       rho = mass(p) / (vol0(p) * detf)
+       speed = sqrt(modulus / rho) + norm2(v(p, :))
+       vmax = max(vmax, speed)
+    end do
+  end subroutine block_max_speed
+
+  !> Gravity of the step at the end of the increment (as the element driver takes loads; a
+  !> load carried over from an earlier step keeps its value: model_time_variation).
+  subroutine step_gravity(m, st)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    integer :: k, s
+    real(dp) :: t_new
+
+    s = st%step
+    t_new = st%step_time + st%dt
+    st%gravity = 0
+    if (allocated(m%steps(s)%gravity)) then
+       do k = 1, size(m%steps(s)%gravity)
+          associate (gl => m%steps(s)%gravity(k))
+            st%gravity = st%gravity + gl%magnitude * gl%direction * &
+                 variation_factor(gl%variation, m%amplitudes, t_new, st%total_time + st%dt)
+          end associate
+       end do
+    end if
+  end subroutine step_gravity
+
+  !> Stencils and P2G, the grid update, the walls, G2P and the MUSL remap of one increment.
+  subroutine musl_transfer(m, st, fx)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    type(mpm_effects_t), intent(inout) :: fx
+    integer :: ib, k, s
+
+    s = st%step
+    call timer_start(fx%timers, fx%id(fx_p2g))
+    call grid_reset_sums(st%g)
+    do ib = 1, st%nblocks
+       call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
+       call p2g(st, st%blocks(ib))
+    end do
+    if (st%nranks > 1) call reduce_grid(st, .true.)
+    st%g%mass_own = st%g%mass
+    st%wall_force = 0
+    do k = 1, size(m%mpm%walls)
+       if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) &
+            call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k))
+    end do
+    call timer_stop(fx%timers, fx%id(fx_p2g))
+
+    call timer_start(fx%timers, fx%id(fx_grid))
+    call grid_update(st, m%mpm%steps(s)%damping)
+    call timer_stop(fx%timers, fx%id(fx_grid))
+    if (fx%active(fx_walls)) then
+       call timer_start(fx%timers, fx%id(fx_walls))
+       do k = 1, size(m%mpm%walls)
+          if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
+          call wall_project(m%mpm%walls(k), st%wall_nodes(k), st%nd, st%g%mass_own, st%g%active, st%g%v_new, &
+               st%dt, st%wall_force(:, k), st%e_walls)
+       end do
+       st%wall_impulse = st%wall_impulse + st%dt * st%wall_force
+       st%impulse_time = st%impulse_time + st%dt
+       call timer_stop(fx%timers, fx%id(fx_walls))
+    end if
+
+    call timer_start(fx%timers, fx%id(fx_g2p))
+    call grid_clear(st%nd * st%g%nn, st%g%mom)
+    do ib = 1, st%nblocks
+       call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
+    end do
+    if (st%nranks > 1) call reduce_grid(st, .false.)
+    do k = 1, size(m%mpm%walls)
+       if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
+    end do
+    call remap_velocity(st)
+    call timer_stop(fx%timers, fx%id(fx_g2p))
+    if (fx%active(fx_walls)) then
+       call timer_start(fx%timers, fx%id(fx_walls))
+       do k = 1, size(m%mpm%walls)
+          if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
+          call wall_project(m%mpm%walls(k), st%wall_nodes(k), st%nd, st%g%mass, st%g%active, st%g%v_new, st%dt)
+       end do
+       call timer_stop(fx%timers, fx%id(fx_walls))
+    end if
+  end subroutine musl_transfer
+
+  !> Sum the grid arrays over ranks: after P2G mass, momentum and force, after the remap momentum.
+  subroutine reduce_grid(st, all_fields)
+    type(mpm_state_t), intent(inout) :: st
+    logical, intent(in) :: all_fields
+    real(dp), allocatable :: buf(:)
+    integer :: nn, nd
+
+    nn = st%g%nn
+    nd = st%nd
+    if (all_fields) then
+       allocate (buf(nn * (1 + 2 * nd)))
+       buf(1:nn) = st%g%mass
+       buf(nn + 1:nn + nd * nn) = reshape(st%g%mom, [nd * nn])
+       buf(nn + nd * nn + 1:) = reshape(st%g%force, [nd * nn])
+       call comm_sum(st%comm, buf)
+       st%g%mass = buf(1:nn)
+       st%g%mom = reshape(buf(nn + 1:nn + nd * nn), [nd, nn])
+       st%g%force = reshape(buf(nn + nd * nn + 1:), [nd, nn])
+    else
+       call comm_sum(st%comm, st%g%mom)
+    end if
+  end subroutine reduce_grid
+
+  !> The block's stencils at its particles' positions; a particle outside the grid is an error.
+  subroutine stencil(st, b, shape, input_file)
+    type(mpm_state_t), intent(in) :: st
+    type(particle_block_t), intent(inout) :: b
+    integer, intent(in) :: shape               !< mpm_scene's shape_linear / shape_gimp
+    character(len=*), intent(in) :: input_file !< for the message
+    integer :: outside
+    character(len=160) :: text
+
+    call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%corner, &
+         b%w1, b%dw1, outside)
+    if (outside /= 0) then
+       write (text, '(a,i0,a,3es12.4,a,es12.5)') 'particle ', b%number(outside), ' at ', b%x(outside, :), &
+            ' left the background grid at t = ', st%total_time
+       call raise_error(trim(input_file), 0, trim(text) // '; expected a *MPM GRID that covers the flow ' // &
+            '(enlarge it, add walls or an *OUTFLOW)')
+    end if
+  end subroutine stencil
+
+  !> Particle to grid: mass, momentum, internal and gravity forces. The particle factors
+  !> (m v, V σ, m g) are formed first in block loops that vectorize; the scatter then does one
+  !> multiply-add per value and node.
+  subroutine p2g(st, b)
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), intent(in) :: b
+    integer :: p, k, nd, nb
+    real(dp) :: vol(b%count)
+    real(dp) :: mv(b%count, st%nd), vs(b%count, st%nc), mg(b%count, st%nd)
+
+    nd = st%nd
+    nb = b%count
+    ! column by column (particle index innermost): the row-wise form was a quarter of p2g
+    do p = 1, nb
+       vol(p) = b%vol0(p) * det_f(b%f, p, nd)
+    end do
+    do k = 1, st%nc
+       vs(:, k) = vol * b%stress_global(:, k)
+    end do
+    do k = 1, nd
+       mv(:, k) = b%mass * b%v(:, k)
+       mg(:, k) = b%mass * st%gravity(k)
+    end do
+    call scatter_p2g(nb, st%nsup, nd, st%nc, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
+         b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
+  end subroutine p2g
+
+  !> v_I^n = p_I/m_I; [local damping f ← f − a|f| sgn v]; v_I^{n+1} = v_I^n + Δt f_I/m_I.
+  subroutine grid_update(st, damping)
+    type(mpm_state_t), intent(inout) :: st
+    real(dp), intent(in) :: damping           !< local damping coefficient a of the step
+    integer :: i, k
+    real(dp) :: a, f, dt, damp
+
+    a = damping
+    dt = st%dt
+    ! Inactive nodes keep zero velocities: both arrays are cleared in one go first (per node,
+    ! `v(:, i) = 0` was a memset call each, two for every inactive node).
+    call grid_clear(st%nd * st%g%nn, st%g%v_old)
+    call grid_clear(st%nd * st%g%nn, st%g%v_new)
+    do i = 1, st%g%nn
+       st%g%active(i) = st%g%mass(i) > st%mass_cutoff
+       if (.not. st%g%active(i)) cycle
+       do k = 1, st%nd
+          st%g%v_old(k, i) = st%g%mom(k, i) / st%g%mass(i)
+          f = st%g%force(k, i)
+          if (a > 0 .and. abs(st%g%v_old(k, i)) > 0 .and. .not. st%on_wall(i)) then
+             ! Cundall's local non-viscous damping: opposes the motion, proportional to |f|
+             damp = a * abs(f)
+             f = f - sign(damp, st%g%v_old(k, i))
+             ! the real material's share of the node (image mass folded in: mpm_mirror)
+             st%e_damping = st%e_damping + damp * abs(st%g%v_old(k, i)) * dt * st%g%mass_own(i) / st%g%mass(i)
+          end if
+          st%g%v_new(k, i) = st%g%v_old(k, i) + dt * f / st%g%mass(i)
+       end do
+    end do
+  end subroutine grid_update
+
+  !> Grid to particles: PIC/FLIP blend (alpha: 1 FLIP, 0 PIC) of the velocity, position from the
+  !> new grid velocity; then (MUSL) the block's new momentum goes back to the grid (st%g%mom,
+  !> zeroed by the caller) while its stencil is at hand.
+  subroutine g2p(st, b, alpha)
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), intent(inout) :: b
+    real(dp), intent(in) :: alpha
+    integer :: p, k, nd, nb
+    real(dp) :: vpic(b%count, st%nd), dv(b%count, st%nd), dt, wk
+
+    nd = st%nd
+    nb = b%count
+    dt = st%dt
+    call gather_velocity(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, st%g%v_new, &
+         st%g%v_old, vpic, dv)
+    wk = 0
+    do k = 1, nd
+       do p = 1, nb
+          b%v(p, k) = alpha * (b%v(p, k) + dv(p, k)) + (1 - alpha) * vpic(p, k)
+          b%x(p, k) = b%x(p, k) + dt * vpic(p, k)
+          wk = wk + b%mass(p) * st%gravity(k) * dt * vpic(p, k)
+          ! from here on dv holds the particle momentum for the remap
+          dv(p, k) = b%mass(p) * b%v(p, k)
+       end do
+    end do
+    st%w_external = st%w_external + wk
+    call scatter_momentum(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, dv, st%g%mom)
+  end subroutine g2p
+
+  !> The remapped velocity v_I = p_I/m_I on the active nodes. Inactive nodes: v_new is still
+  !> grid_update's zero (the walls project active nodes only).
+  subroutine remap_velocity(st)
+    type(mpm_state_t), intent(inout) :: st
+    integer :: i
+
+    do i = 1, st%g%nn
+       if (st%g%active(i)) st%g%v_new(:, i) = st%g%mom(:, i) / st%g%mass(i)
+    end do
+  end subroutine remap_velocity
+end module mpm_musl

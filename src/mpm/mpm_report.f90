@@ -1,0 +1,312 @@
+!> What an MPM run reports: the header and the summary on standard output, the progress line,
+!> the history rows (masses, energies, centre of mass, wall forces; sums over ranks in rank
+!> order) and the field frames (rank 0 gathers every rank's blocks and writes them through
+!> mpm_output).
+module mpm_report
+  use, intrinsic :: iso_fortran_env, only: output_unit, int64
+  use mpi_f08, only: MPI_Comm
+  use base_kinds, only: dp
+  use model, only: model_t
+  use mpm_state, only: mpm_state_t, mpm_effects_t, n_fx, fx_names, sum_over_ranks, max_over_ranks
+  use mpm_particles, only: particle_block_t, block_allocate
+  use mpm_output, only: mpm_writer_t, mpm_writer_frame
+  use output_timer, only: timer_report, clock_text
+  use output_history, only: history_t, history_row
+  use parallel_comm, only: comm_send, comm_recv
+  implicit none
+  private
+
+  public :: header, summary, progress_line, history_columns, measure, write_history, write_frame, gather_blocks
+
+contains
+
+  !> "  step 2/2 DISCHARGE  t = 1.2345E+00  inc 12345  dt 1.234E-04  out kg (rank 0) 12.3  ETA 0:04:10":
+  !> the ETA from this run's wall time per simulated second so far (since the restart, if any).
+  subroutine progress_line(m, st, s, elapsed, sim_start)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(in) :: st
+    integer, intent(in) :: s
+    real(dp), intent(in) :: elapsed, sim_start
+    real(dp) :: remaining, eta
+
+    remaining = m%steps(s)%period - st%step_time
+    if (s < m%n_steps) remaining = remaining + sum(m%steps(s + 1:m%n_steps)%period)
+    eta = 0
+    if (st%total_time > sim_start) eta = elapsed / (st%total_time - sim_start) * remaining
+    write (output_unit, '(a,i0,a,i0,1x,a,a,es11.4,a,i0,a,es10.3,a,es11.4,a,a)') '  step ', s, '/', m%n_steps, &
+         trim(m%steps(s)%name), '  t = ', st%total_time, '  inc ', st%increment, '  dt ', st%dt, &
+         '  out kg (rank 0) ', st%mass_out, '  ETA ', clock_text(eta)
+    flush (output_unit)
+  end subroutine progress_line
+
+  !> A field frame: rank 0 gathers every rank's blocks (in rank order) and writes them.
+  subroutine write_frame(st, wr, step, step_time)
+    type(mpm_state_t), intent(inout) :: st
+    type(mpm_writer_t), intent(inout) :: wr
+    integer, intent(in) :: step
+    real(dp), intent(in) :: step_time
+    type(particle_block_t), allocatable :: all(:)
+    integer :: nall
+
+    if (st%nranks == 1) then
+       call mpm_writer_frame(wr, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time)
+       return
+    end if
+    allocate (all(st%nblocks + 16))
+    call gather_blocks(st, all, nall)
+    if (st%rank == 0) call mpm_writer_frame(wr, all, nall, st%g, step, st%increment, step_time, st%total_time)
+  end subroutine write_frame
+
+  !> Rank 0 receives copies of the other ranks' blocks (what the writer reads of them).
+  subroutine gather_blocks(st, all, nall)
+    type(mpm_state_t), intent(in) :: st
+    type(particle_block_t), allocatable, intent(inout) :: all(:)   !< allocated by the caller
+    integer, intent(out) :: nall
+    integer :: r, k, nb(1), head(5), c, nsv, nfv
+
+    nall = 0
+    if (st%rank /= 0) then
+       nb(1) = st%nblocks
+       call comm_send(st%comm, nb, 0, 1)
+       do k = 1, st%nblocks
+          associate (b => st%blocks(k))
+            c = b%count
+            head = [c, b%material, size(b%state, 2), size(b%field, 2), 0]
+            call comm_send(st%comm, head, 0, 2)
+            call comm_send(st%comm, b%number(1:c), 0, 3)
+            call comm_send(st%comm, packed_block(b, st%nd, st%nc), 0, 4)
+          end associate
+       end do
+       return
+    end if
+    all(1:st%nblocks) = st%blocks(1:st%nblocks)
+    nall = st%nblocks
+    do r = 1, st%nranks - 1
+       call comm_recv(st%comm, nb, r, 1)
+       do k = 1, nb(1)
+          call comm_recv(st%comm, head, r, 2)
+          c = head(1)
+          nsv = head(3)
+          nfv = head(4)
+          if (nall == size(all)) call grow_list(all, nall)
+          nall = nall + 1
+          call block_allocate(all(nall), c, st%nd, st%nc, nsv, nfv, 1)
+          all(nall)%material = head(2)
+          call comm_recv(st%comm, all(nall)%number(1:c), r, 3)
+          call unpack_block(st%comm, r, st%nd, st%nc, nsv, all(nall))
+       end do
+    end do
+  end subroutine gather_blocks
+
+  !> What the writer reads of a block, in one array: x, v, σ, LE, F, V0, m, SDV, half-length.
+  function packed_block(b, nd, nc) result(buf)
+    type(particle_block_t), intent(in) :: b
+    integer, intent(in) :: nd, nc
+    real(dp), allocatable :: buf(:)
+    integer :: c, nsv, off
+
+    c = b%count
+    nsv = size(b%state, 2)
+    allocate (buf(c * (2 * nd + 2 * nc + nd * nd + 2 + nsv) + 1))
+    off = 0
+    buf(off + 1:off + c * nd) = reshape(b%x, [c * nd]); off = off + c * nd
+    buf(off + 1:off + c * nd) = reshape(b%v, [c * nd]); off = off + c * nd
+    buf(off + 1:off + c * nc) = reshape(b%stress_global, [c * nc]); off = off + c * nc
+    buf(off + 1:off + c * nc) = reshape(b%log_strain, [c * nc]); off = off + c * nc
+    buf(off + 1:off + c * nd * nd) = reshape(b%f, [c * nd * nd]); off = off + c * nd * nd
+    buf(off + 1:off + c) = b%vol0; off = off + c
+    buf(off + 1:off + c) = b%mass; off = off + c
+    buf(off + 1:off + c * nsv) = reshape(b%state, [c * nsv]); off = off + c * nsv
+    buf(off + 1) = b%half
+  end function packed_block
+
+  !> Receive a packed_block from rank r into b (allocated for its count).
+  subroutine unpack_block(comm, r, nd, nc, nsv, b)
+    type(MPI_Comm), intent(in) :: comm
+    integer, intent(in) :: r, nd, nc, nsv
+    type(particle_block_t), intent(inout) :: b
+    real(dp), allocatable :: buf(:)
+    integer :: c, off
+
+    c = b%count
+    allocate (buf(c * (2 * nd + 2 * nc + nd * nd + 2 + nsv) + 1))
+    call comm_recv(comm, buf, r, 4)
+    off = 0
+    b%x = reshape(buf(off + 1:off + c * nd), [c, nd]); off = off + c * nd
+    b%v = reshape(buf(off + 1:off + c * nd), [c, nd]); off = off + c * nd
+    b%stress_global = reshape(buf(off + 1:off + c * nc), [c, nc]); off = off + c * nc
+    b%log_strain = reshape(buf(off + 1:off + c * nc), [c, nc]); off = off + c * nc
+    b%f = reshape(buf(off + 1:off + c * nd * nd), [c, nd, nd]); off = off + c * nd * nd
+    b%vol0 = buf(off + 1:off + c); off = off + c
+    b%mass = buf(off + 1:off + c); off = off + c
+    b%state = reshape(buf(off + 1:off + c * nsv), [c, nsv]); off = off + c * nsv
+    b%half = buf(off + 1)
+  end subroutine unpack_block
+
+  subroutine grow_list(list, n)
+    type(particle_block_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(particle_block_t), allocatable :: grown(:)
+    allocate (grown(2 * n + 16))
+    grown(1:n) = list(1:n)
+    call move_alloc(grown, list)
+  end subroutine grow_list
+
+  !> The history's columns: the fixed ones, then three force components per wall.
+  subroutine history_columns(m, columns)
+    type(model_t), intent(in) :: m
+    character(len=32), allocatable, intent(out) :: columns(:)
+    character(len=*), parameter :: fixed(*) = [character(len=32) :: 'time', 'step', 'step_time', 'increment', &
+         'particles', 'MASS', 'MASS_IN', 'MASS_OUT', 'MDR', 'MASS_ERROR', 'ALLKE', 'ALLIE', 'ALLWK', 'ALLFD', &
+         'ALLDMD', 'ETOTAL', 'XCM1', 'XCM2', 'XCM3', 'VCM1', 'VCM2', 'VCM3', 'YTOP', 'GUARDED']
+    integer :: k, n, j
+
+    n = size(m%mpm%walls)
+    allocate (columns(size(fixed) + 3 * n))
+    columns(1:size(fixed)) = fixed
+    j = size(fixed)
+    do k = 1, n
+       columns(j + 1) = 'WALLF1_' // trim(m%mpm%walls(k)%name)
+       columns(j + 2) = 'WALLF2_' // trim(m%mpm%walls(k)%name)
+       columns(j + 3) = 'WALLF3_' // trim(m%mpm%walls(k)%name)
+       j = j + 3
+    end do
+  end subroutine history_columns
+
+  !> Kinetic and internal energy (global sums) of the particles.
+  subroutine measure(st)
+    type(mpm_state_t), intent(inout) :: st
+    integer :: ib
+    real(dp) :: e(2)
+    st%e_kinetic = 0
+    st%e_internal = 0
+    do ib = 1, st%nblocks
+       associate (b => st%blocks(ib))
+         st%e_kinetic = st%e_kinetic + 0.5_dp * sum(b%mass * sum(b%v**2, dim=2))
+         st%e_internal = st%e_internal + sum(b%mass * b%e_int)
+       end associate
+    end do
+    e = [st%e_kinetic, st%e_internal]
+    call sum_over_ranks(st, e)
+    st%e_kinetic = e(1)
+    st%e_internal = e(2)
+  end subroutine measure
+
+  !> One history row: global values (sums over ranks in rank order; collective).
+  subroutine write_history(m, st, hist, last_time, last_out)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    type(history_t), intent(inout) :: hist
+    real(dp), intent(inout) :: last_time, last_out
+    real(dp), allocatable :: row(:)
+    real(dp) :: g(12), top(1), mass, xcm(3), vcm(3), mdr, etotal, mass_out
+    integer :: ib, k, j
+
+    g = 0
+    top = -huge(1.0_dp)
+    do ib = 1, st%nblocks
+       associate (b => st%blocks(ib))
+         g(1) = g(1) + sum(b%mass)
+         do k = 1, st%nd
+            g(1 + k) = g(1 + k) + sum(b%mass * b%x(:, k))
+            g(4 + k) = g(4 + k) + sum(b%mass * b%v(:, k))
+         end do
+         top(1) = max(top(1), maxval(b%x(:, 2)))
+         g(8) = g(8) + b%count
+       end associate
+    end do
+    g(9) = st%mass_out
+    g(10) = st%w_external
+    g(11) = st%e_out
+    g(12) = st%n_guarded
+    call sum_over_ranks(st, g)
+    call max_over_ranks(st, top)
+    mass = g(1)
+    xcm = g(2:4) / mass
+    vcm = g(5:7) / mass
+    mass_out = g(9)
+    mdr = 0
+    if (st%total_time > last_time) mdr = (mass_out - last_out) / (st%total_time - last_time)
+    etotal = st%e_kinetic + st%e_internal + st%e_walls + st%e_damping + g(11) - st%e_in - g(10)
+    allocate (row(24 + 3 * size(m%mpm%walls)))
+    row(1:24) = [st%total_time, real(st%step, dp), st%step_time, real(st%increment, dp), g(8), mass, &
+         st%mass_in, mass_out, mdr, st%mass_initial + st%mass_in - mass_out - mass, st%e_kinetic, &
+         st%e_internal, g(10), st%e_walls, st%e_damping, etotal, xcm, vcm, top(1), g(12)]
+    j = 24
+    do k = 1, size(m%mpm%walls)
+       if (st%impulse_time > 0) then
+          st%wall_force_row(:, k) = st%wall_impulse(:, k) / st%impulse_time
+       else
+          st%wall_force_row(:, k) = st%wall_force(:, k)
+       end if
+       row(j + 1:j + 3) = st%wall_force_row(:, k)
+       j = j + 3
+    end do
+    if (allocated(st%wall_impulse)) st%wall_impulse = 0
+    st%impulse_time = 0
+    call history_row(hist, row)
+    last_time = st%total_time
+    last_out = mass_out
+  end subroutine write_history
+
+  subroutine header(m, st, fx, base)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(in) :: st
+    type(mpm_effects_t), intent(in) :: fx
+    character(len=*), intent(in) :: base
+    character(len=:), allocatable :: list
+    integer :: k
+
+    list = ''
+    do k = 1, n_fx
+       if (.not. fx%active(k)) cycle
+       if (len(list) > 0) list = list // ', '
+       list = list // trim(fx_names(k))
+    end do
+    write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
+    write (output_unit, '(a,i0,a,i0,a,i0,a,es10.3,a,a,a,i0,a)') '  mpm       ', st%nd, 'D, ', &
+         st%n_initial, ' particles, ', st%g%nn, ' grid nodes, cell ', m%mpm%cell, &
+         ', shape ', trim(merge('uGIMP ', 'linear', st%nsup == 3)), ', ', st%nranks, ' rank(s)'
+    write (output_unit, '(a)') '  effects   ' // list
+    write (output_unit, '(a)') '  output    ' // base // '.h5/.xmf (particles), ' // base // '_grid.xmf, ' // &
+         base // '_history.csv'
+    flush (output_unit)
+  end subroutine header
+
+  subroutine summary(m, st, fx, stopped)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    type(mpm_effects_t), intent(in) :: fx
+    logical, intent(in) :: stopped
+    real(dp) :: g(8), rate
+    integer :: ib, k
+
+    call measure(st)
+    g = 0
+    do ib = 1, st%nblocks
+       g(1) = g(1) + sum(st%blocks(ib)%mass)
+       g(2) = g(2) + st%blocks(ib)%count
+    end do
+    g(3:8) = [st%mass_out, real(st%n_out, dp), st%w_external, real(st%n_guarded, dp), &
+         real(st%particle_steps, dp), 0.0_dp]
+    call sum_over_ranks(st, g)
+    call timer_report(fx%timers, output_unit, st%comm)
+    if (st%rank /= 0) return
+    if (stopped) write (output_unit, '(a,i0,a)') 'bulkflow: stopped after increment ', st%increment, &
+         ' as asked (--stop-after); continue with --restart'
+    write (output_unit, '(a,i0,a,es12.5)') 'bulkflow: done, ', st%increment, ' increments, t = ', st%total_time
+    write (output_unit, '(a,i0,a,i0,a,i0,a)') '  particles ', nint(g(2)), ' (', st%n_in, ' in, ', nint(g(4)), ' out)'
+    write (output_unit, '(a,4es14.6,a,es10.2)') '  mass      initial, in, out, now:', st%mass_initial, st%mass_in, &
+         g(3), g(1), '  balance error', st%mass_initial + st%mass_in - g(3) - g(1)
+    write (output_unit, '(a,5es12.4)') '  energies  ALLKE ALLIE ALLWK ALLFD ALLDMD:', st%e_kinetic, st%e_internal, &
+         g(5), st%e_walls, st%e_damping
+    do k = 1, size(m%mpm%walls)
+       write (output_unit, '(a,3es13.5)') '  wall ' // trim(m%mpm%walls(k)%name) // ' force:', st%wall_force_row(:, k)
+    end do
+    if (g(6) > 0) write (output_unit, '(a,i0)') '  particles put back onto walls: ', nint(g(6))
+    rate = g(7) / max(st%loop_seconds, 1.0e-9_dp)
+    write (output_unit, '(a,i0,a,es11.4,a,f10.3,a,i0,a,es11.4,a)') '  throughput ', nint(g(7), int64), &
+         ' particle-steps, ', rate, ' per second (time loop ', st%loop_seconds, ' s, ', st%nranks, &
+         ' ranks: ', rate / st%nranks, ' per rank)'
+  end subroutine summary
+end module mpm_report

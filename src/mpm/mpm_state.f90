@@ -1,0 +1,113 @@
+!> The state of a material-point run that the phases share (mpm_setup, mpm_musl,
+!> mpm_stress_update, mpm_flow, mpm_report, mpm_run): the grid, the rank's particle blocks, the
+!> walls' node lists and mirrors, per-material moduli and VUMAT work sets, the mass and energy
+!> bookkeeping, the clock; and the MPM effects (one switch per effect, a timer for each active
+!> one). Owns the sums over ranks of the run's per-rank values (through src/parallel).
+!> Why one type: every phase reads and writes a few of these fields; one argument keeps the
+!> phases' interfaces short and the checkpoint's list of what to save in one place.
+module mpm_state
+  use, intrinsic :: iso_fortran_env, only: int64
+  use mpi_f08, only: MPI_Comm
+  use base_kinds, only: dp
+  use mpm_grid, only: grid_t
+  use mpm_particles, only: particle_block_t
+  use mpm_walls, only: wall_nodes_t
+  use mpm_mirror, only: mirror_plane_t
+  use material_door, only: vumat_work_t
+  use output_timer, only: timer_set_t
+  use parallel_comm, only: comm_sum, comm_max
+  implicit none
+  private
+
+  ! The MPM effects: the same registry idea as driver_effects (one switch from the scene, a
+  ! timer only for what is active, shares in the report); MPM's own list keeps the FEM one intact.
+  integer, parameter, public :: fx_p2g = 1, fx_grid = 2, fx_g2p = 3, fx_kinematics = 4, fx_material = 5, &
+       fx_user_field = 6, fx_gravity = 7, fx_damping = 8, fx_walls = 9, fx_outflow = 10, fx_inflow = 11, &
+       fx_output = 12, n_fx = 12
+  character(len=16), parameter, public :: fx_names(n_fx) = [character(len=16) :: 'p2g', 'grid update', 'g2p', &
+       'kinematics', 'material', 'user field', 'gravity', 'damping', 'walls', 'outflow', 'inflow', 'output']
+
+  type, public :: mpm_effects_t
+     logical :: active(n_fx) = .false.
+     integer :: id(n_fx) = 0
+     type(timer_set_t) :: timers
+  end type mpm_effects_t
+
+  !> Everything the run keeps. Per-rank partial values (sum over ranks when reported) are
+  !> marked "rank"; the rest is the same on every rank.
+  type, public :: mpm_state_t
+     type(MPI_Comm) :: comm
+     integer :: rank = 0, nranks = 1
+     integer :: nd = 0, nc = 0, nshr = 0, nsup = 0
+     type(grid_t) :: g
+     integer :: nblocks = 0
+     type(particle_block_t), allocatable :: blocks(:)
+     type(wall_nodes_t), allocatable :: wall_nodes(:)
+     !> per wall: a symmetry plane on a node plane is done by mirroring the grid (mpm_mirror)
+     type(mirror_plane_t), allocatable :: mirror(:)
+     logical, allocatable :: mirrored(:)
+     real(dp), allocatable :: modulus(:)             !< per material: λ + 2G (packaging call)
+     logical, allocatable :: needs_kinematics(:)     !< per material: user VUMAT reads F, U
+     !> VUMAT work sets: work(1) has particle_block_size rows (full blocks), work(2) the rows of
+     !> the last partial block (made again when a block of another count comes). Why: with
+     !> exactly nb rows every (1:nb, ...) section the door passes is the whole, contiguous array
+     !> (no pack/unpack copies) and the new stress and state are swapped in, not copied.
+     type(vumat_work_t) :: work(2)
+     integer :: work_statev = 1, work_fieldv = 1     !< columns of the work sets (largest of the materials)
+     integer :: next_number = 0
+     ! mass bookkeeping (exact: particle masses never change)
+     real(dp) :: mass_initial = 0, mass_in = 0, mass_out = 0   !< mass_out: rank
+     integer :: n_initial = 0, n_in = 0, n_out = 0, n_guarded = 0  !< n_out, n_guarded: rank
+     real(dp) :: mass_cutoff = 0
+     ! energies (global sums; 2D per unit thickness)
+     real(dp) :: e_kinetic = 0, e_internal = 0, w_external = 0, e_walls = 0, e_damping = 0
+     real(dp) :: e_out = 0, e_in = 0                 !< w_external, e_out: rank (e_kinetic, e_internal: global after measure)
+     real(dp), allocatable :: wall_force(:, :)       !< (3, n_walls) force of the material on each wall
+     !> Impulse of the material on each wall since the last history row, and the time it took.
+     !> The history reports impulse / time: the force of one increment, m Δv/Δt at the wall
+     !> nodes, also removes the normal velocity the nodes brought into the increment, so it
+     !> scales with 1/Δt; a short final increment made it 2-3.5 times too large.
+     real(dp), allocatable :: wall_impulse(:, :)
+     real(dp), allocatable :: wall_force_row(:, :)   !< the last history row's (mean) wall forces
+     real(dp) :: impulse_time = 0
+     logical, allocatable :: on_wall(:)              !< grid nodes of the walls active in this step
+     ! time
+     integer :: step = 0, increment = 0
+     integer :: step_increment = 0                   !< increments of the running step
+     integer(int64) :: particle_steps = 0           !< Σ over increments of the particle count
+     real(dp) :: loop_seconds = 0                    !< wall time of the time loop
+     real(dp) :: total_time = 0, step_time = 0, dt = 0, dt_stable = 0
+     real(dp) :: gravity(3) = 0
+  end type mpm_state_t
+
+  public :: sum_over_ranks, max_over_ranks, det_f
+
+contains
+
+  !> x ← Σ over the ranks (in place; nothing to do on one rank). Collective.
+  subroutine sum_over_ranks(st, x)
+    type(mpm_state_t), intent(in) :: st
+    real(dp), contiguous, intent(inout) :: x(:)
+    if (st%nranks > 1) call comm_sum(st%comm, x)
+  end subroutine sum_over_ranks
+
+  !> x ← max over the ranks (in place). Collective.
+  subroutine max_over_ranks(st, x)
+    type(mpm_state_t), intent(in) :: st
+    real(dp), contiguous, intent(inout) :: x(:)
+    if (st%nranks > 1) call comm_max(st%comm, x)
+  end subroutine max_over_ranks
+
+  !> det F of particle p (P2G's volume and the stable increment's density use the one formula).
+  pure real(dp) function det_f(f, p, nd)
+    real(dp), intent(in) :: f(:, :, :)   !< a block's F, (count, nd, nd)
+    integer, intent(in) :: p, nd
+    if (nd == 2) then
+       det_f = f(p, 1, 1) * f(p, 2, 2) - f(p, 1, 2) * f(p, 2, 1)
+    else
+       det_f = f(p, 1, 1) * (f(p, 2, 2) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 2)) &
+            - f(p, 1, 2) * (f(p, 2, 1) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 1)) &
+            + f(p, 1, 3) * (f(p, 2, 1) * f(p, 3, 2) - f(p, 2, 2) * f(p, 3, 1))
+    end if
+  end function det_f
+end module mpm_state
