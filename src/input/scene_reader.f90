@@ -11,6 +11,7 @@ module scene_reader
   use scene_digest, only: digest_deck
   use scene_assembly, only: flatten_assembly
   use scene_idioms, only: rewrite_idioms
+  use scene_parameters, only: apply_parameters
   use model, only: model_t
   use scene_layout, only: scene_layout_t, scan_layout
   use scene_mesh, only: mesh_sources_t, build_mesh
@@ -56,6 +57,10 @@ contains
             '(*NODE, *ELEMENT, *MATERIAL, *STEP, ...)', err)
        return
     end if
+    ! *PARAMETER: every <name> replaced by its value first, so the digest and every pass see
+    ! the deck the parameters mean.
+    call apply_parameters(deck, err)
+    if (err%raised) return
     call digest_deck(deck, model%digest)
     ! Parts and instances become the flat deck they mean; a flat deck is left as it is.
     call flatten_assembly(deck, err)
