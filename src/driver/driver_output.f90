@@ -40,7 +40,7 @@ module driver_output
      logical :: progress = .true.
   end type run_output_t
 
-  public :: open_run_output, close_run_output, step_output_start, output_due, write_frame, &
+  public :: open_run_output, next_time_point, time_point_due, close_run_output, step_output_start, output_due, write_frame, &
        write_history, energy_values, progress_line, field_interval, history_interval, &
        output_frequency, sum_over_ranks
 
@@ -178,7 +178,7 @@ contains
          else if (h%number_interval > 0) then
             history_interval = min(history_interval, m%steps(istep)%period / h%number_interval)
          end if
-         if (h%frequency == 0) by_time = .true.
+         if (h%frequency == 0 .and. .not. has_points(h%time_points)) by_time = .true.
        end associate
     end do
     ! Only FREQUENCY= requests: rows by increment count alone.
@@ -209,6 +209,75 @@ contains
       if (f > 0 .and. (output_frequency == 0 .or. f < output_frequency)) output_frequency = f
     end subroutine take
   end function output_frequency
+
+  pure logical function has_points(points)
+    real(dp), allocatable, intent(in) :: points(:)
+
+    has_points = .false.
+    if (allocated(points)) has_points = size(points) > 0
+  end function has_points
+
+  !> The first listed time (TIME POINTS=) of any field or history request of the step after
+  !> t + tol; huge when there is none.
+  real(dp) function next_time_point(m, istep, t, tol)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: istep
+    real(dp), intent(in) :: t, tol
+    integer :: j
+
+    next_time_point = huge(1.0_dp)
+    if (allocated(m%steps(istep)%field_outputs)) then
+       do j = 1, size(m%steps(istep)%field_outputs)
+          call take(m%steps(istep)%field_outputs(j)%time_points)
+       end do
+    end if
+    if (allocated(m%steps(istep)%history_outputs)) then
+       do j = 1, size(m%steps(istep)%history_outputs)
+          call take(m%steps(istep)%history_outputs(j)%time_points)
+       end do
+    end if
+  contains
+    subroutine take(points)
+      real(dp), allocatable, intent(in) :: points(:)
+      integer :: k
+
+      if (.not. has_points(points)) return
+      do k = 1, size(points)
+         if (points(k) > t + tol) then
+            next_time_point = min(next_time_point, points(k))
+            return
+         end if
+      end do
+    end subroutine take
+  end function next_time_point
+
+  !> Does a listed time of the step's field (`field`) or history requests lie in
+  !> (t_prev + tol, t_now + tol]?
+  logical function time_point_due(m, istep, field, t_prev, t_now, tol)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: istep
+    logical, intent(in) :: field
+    real(dp), intent(in) :: t_prev, t_now, tol
+    integer :: j
+
+    time_point_due = .false.
+    if (field .and. allocated(m%steps(istep)%field_outputs)) then
+       do j = 1, size(m%steps(istep)%field_outputs)
+          call take(m%steps(istep)%field_outputs(j)%time_points)
+       end do
+    else if (.not. field .and. allocated(m%steps(istep)%history_outputs)) then
+       do j = 1, size(m%steps(istep)%history_outputs)
+          call take(m%steps(istep)%history_outputs(j)%time_points)
+       end do
+    end if
+  contains
+    subroutine take(points)
+      real(dp), allocatable, intent(in) :: points(:)
+
+      if (.not. has_points(points)) return
+      if (any(points > t_prev + tol .and. points <= t_now + tol)) time_point_due = .true.
+    end subroutine take
+  end function time_point_due
 
   !> At the start of a step: first frame and row at its start time.
   subroutine step_output_start(out)

@@ -20,7 +20,7 @@ module driver_run
        apply_rigid_body_velocities, gravity_forces, apply_contact, gravity_varies_in_step
   use driver_output, only: run_output_t, open_run_output, close_run_output, step_output_start, &
        output_due, write_frame, write_history, energy_values, progress_line, field_interval, &
-       history_interval, output_frequency, sum_over_ranks
+       history_interval, output_frequency, sum_over_ranks, next_time_point, time_point_due
   use driver_checkpoint, only: save_checkpoint, load_checkpoint
   use driver_mass_scaling, only: apply_step_mass_scaling
   use driver_finite, only: energies_finite, stop_non_finite, non_finite_flag
@@ -190,7 +190,7 @@ contains
     type(step_loads_t), intent(in) :: loads
     integer, intent(in) :: istep
     real(dp), intent(out) :: dt_min
-    real(dp) :: dt, dt_avg, t_mid, t_new, work, free_sum
+    real(dp) :: dt, dt_avg, t_mid, t_new, t_point, work, free_sum
     integer :: i, dt_elem
     logical :: gravity_varies
 
@@ -202,9 +202,15 @@ contains
          dt = s%dt_scale * stable_dt_safety * solver%dt_stable
       end if
       dt = min(dt, s%period - solver%step_time)
+      ! TIME POINTS= output: the increment is cut to end exactly on the next listed time.
+      t_point = next_time_point(m, istep, solver%step_time, 1.0e-9_dp * s%period)
+      t_new = solver%step_time + dt
+      if (t_point - solver%step_time <= dt) then
+         dt = t_point - solver%step_time
+         t_new = t_point
+      end if
       solver%dt = dt
       t_mid = solver%step_time + 0.5_dp * dt
-      t_new = solver%step_time + dt
 
       ! Velocities at mid-increment (the first increment of the run starts from v_0 with dt/2).
       dt_avg = merge(0.5_dp * dt, 0.5_dp * (solver%dt_prev + dt), solver%increment == 0)
@@ -518,11 +524,13 @@ contains
     type(run_output_t), intent(inout) :: out
     type(effects_t), intent(inout) :: effects
     integer, intent(in) :: istep
-    real(dp) :: period, interval
+    real(dp) :: period, interval, t_prev
     integer :: frequency
     logical :: due, step_end
 
     period = m%steps(istep)%period
+    ! TIME POINTS=: a listed time in (t_prev, t] (the start of the step: t itself).
+    t_prev = merge(-huge(1.0_dp), solver%step_time - solver%dt, solver%step_increment == 0)
     call effects%start(effect_output)
     ! FREQUENCY=n requests: every n-th increment of the step and the step's end.
     step_end = solver%step_time >= period * (1 - 1.0e-12_dp)
@@ -531,6 +539,7 @@ contains
     due = .false.
     if (interval > 0) due = output_due(solver%step_time, out%next_field, period, solver%dt)
     if (frequency > 0) due = due .or. mod(solver%step_increment, frequency) == 0 .or. step_end
+    if (time_point_due(m, istep, .true., t_prev, solver%step_time, 1.0e-9_dp * period)) due = .true.
     if (due) then
        call write_frame(m, solver, out, istep)
        if (interval > 0) then
@@ -544,6 +553,7 @@ contains
     due = .false.
     if (interval > 0) due = output_due(solver%step_time, out%next_history, period, solver%dt)
     if (frequency > 0) due = due .or. mod(solver%step_increment, frequency) == 0 .or. step_end
+    if (time_point_due(m, istep, .false., t_prev, solver%step_time, 1.0e-9_dp * period)) due = .true.
     if (due) then
        call write_history(m, solver, out, istep)
        if (interval > 0) then

@@ -114,17 +114,23 @@ contains
     call build_steps(deck, layout, model, err)
   end subroutine read_scene
 
-  !> The MPM run writes output by time only.
+  !> The MPM run writes output at regular times only (no FREQUENCY=, no TIME POINTS=).
   subroutine refuse_frequency(deck, err)
     type(keyword_deck_t), intent(in) :: deck
     type(error_t), intent(inout) :: err
     integer :: i
 
     do i = 1, deck%n_blocks
-       if (deck%blocks(i)%name /= 'OUTPUT' .or. .not. deck%blocks(i)%has_param('FREQUENCY')) cycle
-       call deck%blocks(i)%fail('*OUTPUT, FREQUENCY= in a material-point scene; expected NUMBER INTERVAL=n ' // &
-            'or TIME INTERVAL=t (the MPM run writes output by time)', err)
-       return
+       if (deck%blocks(i)%name /= 'OUTPUT') cycle
+       if (deck%blocks(i)%has_param('FREQUENCY')) then
+          call deck%blocks(i)%fail('*OUTPUT, FREQUENCY= in a material-point scene; expected NUMBER INTERVAL=n ' // &
+               'or TIME INTERVAL=t (the MPM run writes output by time)', err)
+          return
+       else if (deck%blocks(i)%has_param('TIME POINTS')) then
+          call deck%blocks(i)%fail('*OUTPUT, TIME POINTS= in a material-point scene is not supported (the ' // &
+               'MPM output schedule is periodic); expected NUMBER INTERVAL=n or TIME INTERVAL=t', err)
+          return
+       end if
     end do
   end subroutine refuse_frequency
 
