@@ -12,6 +12,7 @@ module scene_reader
   use scene_assembly, only: flatten_assembly
   use scene_idioms, only: rewrite_idioms
   use scene_parameters, only: apply_parameters
+  use scene_discrete_rigid, only: rewrite_discrete_rigid
   use model, only: model_t
   use scene_layout, only: scene_layout_t, scan_layout
   use scene_mesh, only: mesh_sources_t, build_mesh
@@ -67,6 +68,9 @@ contains
     if (err%raised) return
     ! Print requests dropped (noted), model-level *RESTART and general contact restated.
     call rewrite_idioms(deck, model%notes, err)
+    if (err%raised) return
+    ! R2D2 walls of a *RIGID BODY, ELSET= become the analytic SEGMENTS surfaces they describe.
+    call rewrite_discrete_rigid(deck, err)
     if (err%raised) return
     call scan_layout(deck, layout, err)
     if (err%raised) return
