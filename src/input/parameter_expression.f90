@@ -12,6 +12,7 @@
 !>   atom   := number | 'string' | "string" | name | name '(' sum {',' sum} ')' | '(' sum ')'
 module parameter_expression
   use, intrinsic :: iso_fortran_env, only: int64
+  use keyword_numbers, only: int_text
   use parameter_arithmetic, only: param_value_t, kind_integer, kind_real, kind_string, value_text, &
        binary_operation, call_function, pi, euler
   implicit none
@@ -207,7 +208,7 @@ contains
        c%pos = c%pos + 1
        call parse_sum(c, known, n, v)
        if (len(c%problem) > 0) return
-       call expect(c, ')', 'a ")" to close the "(" at column ' // itoa(start))
+       call expect(c, ')', 'a ")" to close the "(" at column ' // int_text(start))
     else if (is_digit(ch) .or. ch == '.') then
        call parse_number(c, v)
     else if (ch == '"' .or. ch == "'") then
@@ -436,15 +437,6 @@ contains
 
     is_letter = (ch >= 'a' .and. ch <= 'z') .or. (ch >= 'A' .and. ch <= 'Z') .or. ch == '_'
   end function is_letter
-
-  pure function itoa(i) result(t)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: t
-    character(len=12) :: buf
-
-    write (buf, '(i0)') i
-    t = trim(buf)
-  end function itoa
 
   !> v = v op rhs, or the problem at column `where`.
   pure subroutine binary(c, op, v, rhs, where)

@@ -13,6 +13,7 @@ module scene_parameters
        reparse_keyword_line
   use parameter_expression, only: named_value_t, evaluate_expression, value_text, is_parameter_name
   use parameter_arithmetic, only: param_value_t
+  use scene_util, only: itoa
   implicit none
   private
 
@@ -212,12 +213,4 @@ contains
     if (n > 12) t = t // ', ...'
   end function defined_list
 
-  pure function itoa(i) result(t)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: t
-    character(len=12) :: buf
-
-    write (buf, '(i0)') i
-    t = trim(buf)
-  end function itoa
 end module scene_parameters

@@ -20,11 +20,13 @@ from __future__ import annotations
 
 import argparse
 import re
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from scene_tools import run_deck as run, verify_deck  # noqa: E402
 
 
 
@@ -45,12 +47,6 @@ def decks(text: str) -> tuple[str, str]:
     return analytic, discrete
 
 
-def run(bulkflow: str, deck: Path, base: Path) -> None:
-    p = subprocess.run([bulkflow, str(deck), '--output', str(base)], capture_output=True, text=True, timeout=300)
-    if p.returncode != 0:
-        raise SystemExit(f'FAIL: {deck.name} exited {p.returncode}:\n{p.stdout}\n{p.stderr}')
-
-
 def main() -> int:
     p = argparse.ArgumentParser()
     p.add_argument('scene', type=Path)
@@ -62,11 +58,7 @@ def main() -> int:
     (a.workdir / 'incline_analytic.inp').write_text(analytic)
     deck = a.workdir / 'incline_r2d2.inp'
     deck.write_text(discrete)
-    verify = subprocess.run([sys.executable, str(Path(__file__).parent / 'check_scene.py'), 'verify', str(deck),
-                             '--bulkflow', a.bulkflow, '--workdir', str(a.workdir / 'verify')],
-                            capture_output=True, text=True, timeout=300)
-    print(verify.stdout.rstrip())
-    failures = int(verify.returncode != 0)
+    failures = int(not verify_deck(a.bulkflow, deck, a.workdir / 'verify'))
     run(a.bulkflow, a.workdir / 'incline_analytic.inp', a.workdir / 'analytic')
     run(a.bulkflow, deck, a.workdir / 'discrete')
     h1 = np.genfromtxt(a.workdir / 'analytic_history.csv', delimiter=',', names=True)

@@ -17,12 +17,14 @@ from __future__ import annotations
 import argparse
 import math
 import re
-import subprocess
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'scripts'))
 from compare_binaries import h5_differences  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from scene_tools import run_deck as run  # noqa: E402
 
 DEFINITIONS = """\
 alpha_deg = 30
@@ -138,12 +140,6 @@ def written_out(deck: str) -> str:
 
 def text_of(value: object) -> str:
     return value if isinstance(value, str) else repr(value)
-
-
-def run(bulkflow: str, deck: Path, base: Path) -> None:
-    p = subprocess.run([bulkflow, str(deck), '--output', str(base)], capture_output=True, text=True, timeout=300)
-    if p.returncode != 0:
-        raise SystemExit(f'FAIL: {deck.name} exited {p.returncode}:\n{p.stdout}\n{p.stderr}')
 
 
 def main() -> int:

@@ -16,12 +16,14 @@ a multiple of the stable increment) and a history request at a GENERATE list (0 
 from __future__ import annotations
 
 import argparse
-import subprocess
 import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from scene_tools import verify_deck  # noqa: E402
 
 FRAMES = [0.0, 0.013, 0.05, 0.1234, 0.3999]
 OUTPUTS = """\
@@ -57,11 +59,7 @@ def main() -> int:
     head = head.replace('*STEP, NAME=SLIDE', DEFINITIONS + '*STEP, NAME=SLIDE')
     deck = a.workdir / 'incline_time_points.inp'
     deck.write_text(head + OUTPUTS)
-    verify = subprocess.run([sys.executable, str(Path(__file__).parent / 'check_scene.py'), 'verify', str(deck),
-                             '--bulkflow', a.bulkflow, '--workdir', str(a.workdir / 'verify')],
-                            capture_output=True, text=True, timeout=300)
-    print(verify.stdout.rstrip())
-    failures = verify.returncode != 0
+    failures = not verify_deck(a.bulkflow, deck, a.workdir / 'verify')
     base = next((a.workdir / 'verify').glob('*.h5')).with_suffix('')
     with h5py.File(f'{base}.h5', 'r') as f:
         times = [float(f['frames'][k].attrs['step_time']) for k in sorted(f['frames'])]
