@@ -41,7 +41,7 @@ contains
                return
             end if
             do j = 1, blk%n_lines
-               call define(blk%lines(j), known, n, err)
+               call define_statements(blk%lines(j), known, n, err)
                if (err%raised) return
             end do
          case ('PARAMETER TABLE', 'PARAMETER TABLE TYPE', 'PARAMETER DEPENDENCE', 'PARAMETER SHAPE VARIATION', &
@@ -67,8 +67,32 @@ contains
     deck%n_blocks = kept
   end subroutine apply_parameters
 
-  !> One `name = expression` line of *PARAMETER (a Python comment may follow).
-  subroutine define(dl, known, n, err)
+  !> A *PARAMETER line: assignments separated by ';' (Python's statement separator; a trailing
+  !> ';' is allowed), a '#' comment at the end.
+  subroutine define_statements(dl, known, n, err)
+    type(data_line_t), intent(in) :: dl
+    type(named_value_t), allocatable, intent(inout) :: known(:)
+    integer, intent(inout) :: n
+    type(error_t), intent(inout) :: err
+    character(len=:), allocatable :: text
+    integer :: hash, semi
+
+    text = dl%text
+    hash = index(text, '#')
+    if (hash > 0) text = text(1:hash - 1)
+    do
+       semi = index(text, ';')
+       if (semi == 0) exit
+       if (len_trim(text(1:semi - 1)) > 0) call define(text(1:semi - 1), dl, known, n, err)
+       if (err%raised) return
+       text = text(semi + 1:)
+    end do
+    if (len_trim(text) > 0 .or. index(dl%text, ';') == 0) call define(text, dl, known, n, err)
+  end subroutine define_statements
+
+  !> One `name = expression` statement of a *PARAMETER line.
+  subroutine define(statement, dl, known, n, err)
+    character(len=*), intent(in) :: statement
     type(data_line_t), intent(in) :: dl
     type(named_value_t), allocatable, intent(inout) :: known(:)
     integer, intent(inout) :: n
@@ -78,7 +102,7 @@ contains
     character(len=:), allocatable :: text, name, problem
     integer :: eq, column, k
 
-    text = dl%text
+    text = statement
     eq = index(text, '=')
     name = ''
     if (eq > 1) name = trim(adjustl(text(1:eq - 1)))
