@@ -243,13 +243,16 @@ contains
     real(dp), intent(in) :: x, y
     real(dp), parameter :: big = huge(1.0_dp)
 
+    ! (Fortran may evaluate both sides of .and.: each quotient and product below is guarded
+    ! by an if, so the check itself never divides by zero or overflows.)
+    overflows = .false.
     select case (op)
     case ('+', '-')
        overflows = abs(x) > 0.5_dp * big .and. abs(y) > 0.5_dp * big
     case ('*')
-       overflows = abs(y) > 1.0_dp .and. abs(x) > big / abs(y)
+       if (abs(y) > 1.0_dp) overflows = abs(x) > big / abs(y)
     case ('/', '//', '%')
-       overflows = abs(y) < 1.0_dp .and. abs(x) > big * abs(y)
+       if (abs(y) < 1.0_dp) overflows = abs(x) > big * abs(y)
     case ('**')
        overflows = .false.
        if (abs(x) > 0.0_dp) overflows = y * log(abs(x)) > 709.0_dp

@@ -111,10 +111,8 @@ contains
     type(rigid_elements_t), intent(inout) :: r
     character(len=*), intent(in) :: set
     integer, intent(in) :: element
-    character(len=64) :: name
 
-    name = set
-    r%set_name = [r%set_name, name]
+    call push(r%set_name, set)
     r%set_element = [r%set_element, element]
   end subroutine add_member
 
@@ -164,7 +162,6 @@ contains
     type(rigid_elements_t), intent(inout) :: r
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: name, kind, face, label
-    character(len=64) :: record
     integer, allocatable :: a(:), b(:), order(:)
     type(data_line_t), allocatable :: lines(:)
     integer :: j, k, e, id
@@ -227,10 +224,8 @@ contains
        end if
     end do
     do j = 1, blk%n_lines
-       record = upper(blk%lines(j)%field(1))
-       r%surface_label = [r%surface_label, record]
-       record = name
-       r%surface_name = [r%surface_name, record]
+       call push(r%surface_label, upper(blk%lines(j)%field(1)))
+       call push(r%surface_name, name)
     end do
     call reparse_keyword_line(blk, '*SURFACE, TYPE=SEGMENTS, NAME=' // name, err)
     call move_alloc(lines, blk%lines)
@@ -328,6 +323,21 @@ contains
     call reparse_keyword_line(blk, '*RIGID BODY, REF NODE=' // ref // ', ANALYTICAL SURFACE=' // surface, err)
     blk%n_lines = 0
   end subroutine rigid_body_surface
+
+  !> Append to a list of names (grown by hand: gfortran's -fcheck=all refuses the array
+  !> constructor [zero-size list, name] although both have length 64).
+  subroutine push(list, text)
+    character(len=64), allocatable, intent(inout) :: list(:)
+    character(len=*), intent(in) :: text
+    character(len=64), allocatable :: grown(:)
+    integer :: n
+
+    n = size(list)
+    allocate (grown(n + 1))
+    grown(1:n) = list
+    grown(n + 1) = text
+    call move_alloc(grown, list)
+  end subroutine push
 
   integer function atoi(t)
     character(len=*), intent(in) :: t
