@@ -41,7 +41,7 @@ module driver_output
   end type run_output_t
 
   public :: open_run_output, close_run_output, step_output_start, write_frame, &
-       write_history, energy_values, progress_line, sum_over_ranks
+       write_history, energy_values, progress_line, sum_over_ranks, next_time_point
 
 contains
 
@@ -142,6 +142,47 @@ contains
     out%fields_open = .false.
     call history_close(out%history)
   end subroutine close_run_output
+
+  pure logical function has_points(points)
+    real(dp), allocatable, intent(in) :: points(:)
+
+    has_points = .false.
+    if (allocated(points)) has_points = size(points) > 0
+  end function has_points
+
+  !> The first listed time (TIME POINTS=) of any field or history request of the step after
+  !> t + tol; huge when there is none.
+  real(dp) function next_time_point(m, istep, t, tol)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: istep
+    real(dp), intent(in) :: t, tol
+    integer :: j
+
+    next_time_point = huge(1.0_dp)
+    if (allocated(m%steps(istep)%field_outputs)) then
+       do j = 1, size(m%steps(istep)%field_outputs)
+          call take(m%steps(istep)%field_outputs(j)%time_points)
+       end do
+    end if
+    if (allocated(m%steps(istep)%history_outputs)) then
+       do j = 1, size(m%steps(istep)%history_outputs)
+          call take(m%steps(istep)%history_outputs(j)%time_points)
+       end do
+    end if
+  contains
+    subroutine take(points)
+      real(dp), allocatable, intent(in) :: points(:)
+      integer :: k
+
+      if (.not. has_points(points)) return
+      do k = 1, size(points)
+         if (points(k) > t + tol) then
+            next_time_point = min(next_time_point, points(k))
+            return
+         end if
+      end do
+    end subroutine take
+  end function next_time_point
 
   !> At the start of a step (or where a restart continues it, at step time `resume_time`): the
   !> step's frame and row schedules.

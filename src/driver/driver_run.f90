@@ -19,7 +19,7 @@ module driver_run
   use driver_loads, only: step_loads_t, prepare_step, apply_prescribed_velocities, &
        apply_rigid_body_velocities, gravity_forces, apply_contact, gravity_varies_in_step
   use driver_output, only: run_output_t, open_run_output, close_run_output, step_output_start, &
-       write_frame, write_history, energy_values, progress_line, sum_over_ranks
+       write_frame, write_history, energy_values, progress_line, sum_over_ranks, next_time_point
   use driver_checkpoint, only: save_checkpoint, load_checkpoint
   use driver_mass_scaling, only: apply_step_mass_scaling
   use driver_pressure, only: step_pressures_t, prepare_pressures, add_pressure_forces
@@ -200,7 +200,7 @@ contains
     type(step_pressures_t), intent(in) :: pressures
     integer, intent(in) :: istep
     real(dp), intent(out) :: dt_min
-    real(dp) :: dt, dt_avg, t_mid, t_new, work, free_sum
+    real(dp) :: dt, dt_avg, t_mid, t_new, t_point, work, free_sum
     integer :: i, dt_elem
     logical :: gravity_varies
 
@@ -212,9 +212,15 @@ contains
          dt = s%dt_scale * stable_dt_safety * solver%dt_stable
       end if
       dt = min(dt, s%period - solver%step_time)
+      ! TIME POINTS= output: the increment is cut to end exactly on the next listed time.
+      t_point = next_time_point(m, istep, solver%step_time, 1.0e-9_dp * s%period)
+      t_new = solver%step_time + dt
+      if (t_point - solver%step_time <= dt) then
+         dt = t_point - solver%step_time
+         t_new = t_point
+      end if
       solver%dt = dt
       t_mid = solver%step_time + 0.5_dp * dt
-      t_new = solver%step_time + dt
 
       ! Velocities at mid-increment (the first increment of the run starts from v_0 with dt/2).
       dt_avg = merge(0.5_dp * dt, 0.5_dp * (solver%dt_prev + dt), solver%increment == 0)

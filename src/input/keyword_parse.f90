@@ -98,6 +98,34 @@ contains
     is_directory = there
   end function is_directory
 
+  module subroutine set_line_text(dl, text)
+    type(data_line_t), intent(inout) :: dl
+    character(len=*), intent(in) :: text
+    type(source_t), pointer :: own
+
+    allocate (own)
+    if (associated(dl%file)) own%name = dl%file
+    own%text = text
+    allocate (own%bounds(64))
+    call field_bounds(own%text, own%bounds, own%n_bounds)
+    dl%src => own
+    dl%text => own%text
+    dl%first = 0
+    dl%nf = own%n_bounds / 2
+  end subroutine set_line_text
+
+  module subroutine reparse_keyword_line(blk, text, err)
+    type(keyword_block_t), intent(inout) :: blk
+    character(len=*), intent(in) :: text
+    type(error_t), intent(inout) :: err
+    type(keyword_block_t) :: again
+
+    call parse_keyword_line(text, blk%file, blk%line, again, err)
+    if (err%raised) return
+    call move_alloc(again%name, blk%name)
+    call move_alloc(again%params, blk%params)
+  end subroutine reparse_keyword_line
+
   !> Parse one source into `deck` (appending); recursive for *INCLUDE.
   recursive subroutine parse_source(src, deck, depth, err)
     type(source_t), pointer, intent(in) :: src

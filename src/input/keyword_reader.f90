@@ -33,7 +33,7 @@ module keyword_reader
 
   public :: keyword_param_t, data_line_t, keyword_block_t, keyword_deck_t
   public :: read_keyword_file, read_keyword_string
-  public :: set_field, keep_fields
+  public :: set_field, keep_fields, set_line_text, reparse_keyword_line
   public :: upper_case, is_real_text, is_integer_text, is_integer_syntax
 
   !> Deepest *INCLUDE nesting accepted; deeper means a circular include.
@@ -113,6 +113,21 @@ module keyword_reader
        type(error_t), intent(inout), optional :: err
        character(len=*), intent(in), optional :: name
      end subroutine read_keyword_string
+
+     !> Replace a data line's whole text (split into fields again), e.g. after `<name>`
+     !> substitution; the line owns its new text, the file's buffer is not written.
+     module subroutine set_line_text(dl, text)
+       type(data_line_t), intent(inout) :: dl
+       character(len=*), intent(in) :: text
+     end subroutine set_line_text
+
+     !> Parse `text` ("*NAME, P=v, ...") again as the keyword line of `blk`; its data lines,
+     !> file and line stay.
+     module subroutine reparse_keyword_line(blk, text, err)
+       type(keyword_block_t), intent(inout) :: blk
+       character(len=*), intent(in) :: text
+       type(error_t), intent(inout) :: err
+     end subroutine reparse_keyword_line
   end interface
 
 contains

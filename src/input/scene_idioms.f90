@@ -3,8 +3,7 @@
 !> * print and file requests (*PREPRINT, *NODE PRINT, *CONTACT OUTPUT, *DIAGNOSTICS, ...)
 !>   cannot change results: dropped, with one note per keyword naming the first line;
 !> * *PHYSICAL CONSTANTS (temperatures, radiation, gases: nothing a mechanical explicit run
-!>   uses) and *TIME POINTS (a definition; using it on *OUTPUT is refused there): dropped
-!>   with a note;
+!>   uses): dropped with a note;
 !> * *SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=HARD: our contact is hard (kinematic) contact
 !>   that lets surfaces separate, so it is checked and dropped; NO SEPARATION and the softened
 !>   laws are refused;
@@ -38,8 +37,6 @@ contains
             'wall forces and the increment are in BASE_history.csv'
     case ('PHYSICAL CONSTANTS')
        reason = 'constants for temperature, radiation and gases, which a mechanical explicit run does not use'
-    case ('TIME POINTS')
-       reason = 'a list of times; *OUTPUT, TIME POINTS= is refused, use NUMBER INTERVAL, TIME INTERVAL or FREQUENCY'
     case default
        reason = ''
     end select

@@ -17,6 +17,7 @@ module scene_outputs
   use model_sets, only: find_set
   use model_steps, only: field_output_t, history_output_t
   use scene_util, only: itoa, field_name, field_blank, get_real_param, expect_lines
+  use scene_time_points, only: time_points_t, find_time_points
   implicit none
   private
 
@@ -35,6 +36,8 @@ module scene_outputs
      integer :: current_number = 0
      real(dp) :: current_time = 0
      integer :: current_frequency = 0
+     real(dp), allocatable :: current_points(:)
+     type(time_points_t), allocatable :: lists(:)   !< the deck's *TIME POINTS
   end type output_state_t
 
 contains
@@ -69,13 +72,9 @@ contains
             '*OUTPUT, HISTORY', err)
        return
     end if
-    if (blk%has_param('TIME POINTS')) then
-       call blk%fail('*OUTPUT, TIME POINTS= (output at listed times) is not supported; expected ' // &
-            'NUMBER INTERVAL=n, TIME INTERVAL=t or FREQUENCY=n', err)
-       return
-    end if
-    if (count([blk%has_param('NUMBER INTERVAL'), blk%has_param('TIME INTERVAL'), blk%has_param('FREQUENCY')]) > 1) then
-       call blk%fail('*OUTPUT with more than one of NUMBER INTERVAL, TIME INTERVAL and FREQUENCY; ' // &
+    if (count([blk%has_param('NUMBER INTERVAL'), blk%has_param('TIME INTERVAL'), blk%has_param('FREQUENCY'), &
+         blk%has_param('TIME POINTS')]) > 1) then
+       call blk%fail('*OUTPUT with more than one of NUMBER INTERVAL, TIME INTERVAL, FREQUENCY and TIME POINTS; ' // &
             'expected one of them', err)
        return
     end if
@@ -85,6 +84,7 @@ contains
     if (.not. err%raised) call blk%get_integer('NUMBER INTERVAL', n, err, default=0, minimum=1)
     if (.not. err%raised) call blk%get_integer('FREQUENCY', frequency, err, default=0, minimum=1)
     if (.not. err%raised) call get_real_param(blk, 'TIME INTERVAL', t, err, default=0.0_dp)
+    if (.not. err%raised) call time_points_of(blk, os, err)
     if (err%raised) return
     if (blk%has_param('TIME INTERVAL') .and. .not. (t > 0)) then
        call blk%fail('*OUTPUT: TIME INTERVAL must be positive; expected a time > 0', err)
@@ -98,7 +98,7 @@ contains
        return
     end if
     os%current_is_field = blk%has_param('FIELD')
-    if (n == 0 .and. .not. (t > 0) .and. frequency == 0) n = merge(default_field_intervals, &
+    if (n == 0 .and. .not. (t > 0) .and. frequency == 0 .and. .not. blk%has_param('TIME POINTS')) n = merge(default_field_intervals, &
          default_history_intervals, os%current_is_field)
     os%current_number = n
     os%current_time = t
@@ -108,6 +108,7 @@ contains
        f%number_interval = n
        f%time_interval = t
        f%frequency = frequency
+       if (allocated(os%current_points)) allocate (f%time_points, source=os%current_points)
        allocate (f%node_variables(0), f%element_variables(0))
        if (variable == 'PRESELECT') then
           f%node_variables = [character(len=8) :: 'U', 'V', 'A', 'RF']
@@ -131,6 +132,33 @@ contains
 
     call blk%get_string('TIME MARKS', marks, err, default='NO', choices=[character(len=3) :: 'YES', 'NO'])
   end subroutine time_marks
+
+  !> TIME POINTS=name: the times of the *TIME POINTS list of that name (none: an empty list).
+  subroutine time_points_of(blk, os, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(output_state_t), intent(inout) :: os
+    type(error_t), intent(inout) :: err
+    character(len=:), allocatable :: name, known
+    integer :: k
+
+    os%current_points = [real(dp) ::]
+    if (.not. blk%has_param('TIME POINTS')) return
+    call blk%get_string('TIME POINTS', name, err)
+    if (err%raised) return
+    if (.not. allocated(os%lists)) allocate (os%lists(0))
+    k = find_time_points(os%lists, name)
+    if (k == 0) then
+       known = 'none defined'
+       if (size(os%lists) > 0) known = 'defined: ' // os%lists(1)%name
+       do k = 2, size(os%lists)
+          known = known // ', ' // os%lists(k)%name
+       end do
+       call blk%fail('*OUTPUT, TIME POINTS=' // name // ': no *TIME POINTS, NAME=' // name // ' (' // known // &
+            '); expected the name of a *TIME POINTS list', err)
+       return
+    end if
+    os%current_points = os%lists(k)%times
+  end subroutine time_points_of
 
   !> Drop the requests of one kind inherited from earlier steps (OP=NEW).
   subroutine drop_inherited(os, field)
@@ -184,6 +212,7 @@ contains
     h%number_interval = os%current_number
     h%time_interval = os%current_time
     h%frequency = os%current_frequency
+    if (allocated(os%current_points)) allocate (h%time_points, source=os%current_points)
     h%nset = nset
     h%energies = energies
     allocate (h%node_variables(0))

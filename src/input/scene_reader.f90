@@ -11,6 +11,8 @@ module scene_reader
   use scene_digest, only: digest_deck
   use scene_assembly, only: flatten_assembly
   use scene_idioms, only: rewrite_idioms
+  use scene_parameters, only: apply_parameters
+  use scene_discrete_rigid, only: rewrite_discrete_rigid
   use model, only: model_t
   use scene_layout, only: scene_layout_t, scan_layout
   use scene_mesh, only: mesh_sources_t, build_mesh
@@ -56,12 +58,19 @@ contains
             '(*NODE, *ELEMENT, *MATERIAL, *STEP, ...)', err)
        return
     end if
+    ! *PARAMETER: every <name> replaced by its value first, so the digest and every pass see
+    ! the deck the parameters mean.
+    call apply_parameters(deck, err)
+    if (err%raised) return
     call digest_deck(deck, model%digest)
     ! Parts and instances become the flat deck they mean; a flat deck is left as it is.
     call flatten_assembly(deck, err)
     if (err%raised) return
     ! Print requests dropped (noted), model-level *RESTART and general contact restated.
     call rewrite_idioms(deck, model%notes, err)
+    if (err%raised) return
+    ! R2D2 walls of a *RIGID BODY, ELSET= become the analytic SEGMENTS surfaces they describe.
+    call rewrite_discrete_rigid(deck, err)
     if (err%raised) return
     call scan_layout(deck, layout, err)
     if (err%raised) return
@@ -86,6 +95,7 @@ contains
        if (err%raised) return
        call count_user_fields(model)
        call build_steps(deck, layout, model, err)
+       if (.not. err%raised) call refuse_time_points(deck, err)
        return
     end if
     call build_mesh(deck, layout, model, sources, err)
@@ -111,6 +121,23 @@ contains
     call count_user_fields(model)
     call build_steps(deck, layout, model, err)
   end subroutine read_scene
+
+  !> The MPM run has no increment cutting onto listed times: TIME POINTS= is refused there.
+  subroutine refuse_time_points(deck, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(error_t), intent(inout) :: err
+    integer :: i
+
+    do i = 1, deck%n_blocks
+       if (deck%blocks(i)%name /= 'OUTPUT') cycle
+       if (deck%blocks(i)%has_param('TIME POINTS')) then
+          call deck%blocks(i)%fail('*OUTPUT, TIME POINTS= in a material-point scene is not supported (the ' // &
+               'MPM run does not cut its increments onto listed times); expected NUMBER INTERVAL=n, ' // &
+               'TIME INTERVAL=t or FREQUENCY=n', err)
+          return
+       end if
+    end do
+  end subroutine refuse_time_points
 
   !> A user's VUMAT or VUSDFLD receives every field variable the scene defines (nfieldv = the
   !> highest VARIABLE= of *INITIAL CONDITIONS, TYPE=FIELD, or FIELDS= of *USER DEFINED FIELD if

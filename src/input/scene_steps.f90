@@ -34,6 +34,7 @@ module scene_steps
   use scene_pressure, only: read_dsload
   use model_time_variation, only: time_variation_t, carry_into_step
   use scene_outputs, only: output_state_t, outputs_step_start, read_output, read_output_option, time_marks
+  use scene_time_points, only: build_time_points
   use scene_surfaces, only: find_rigid_surface, require_element_surface
   use scene_interactions, only: find_interaction
   use scene_util, only: itoa, rtoa, get_real, get_real_param, field_name, field_blank, &
@@ -76,6 +77,8 @@ contains
 
     call bc_init(c%bcs, model%mesh%n_nodes)
     allocate (c%gravity(0), c%pressures(0), c%pairs(0), c%mass_scaling(0), c%temperatures(0))
+    call build_time_points(deck, c%outputs%lists, err)
+    if (err%raised) return
     do i = 1, deck%n_blocks
        if (layout%step_of(i) /= 0) cycle
        select case (deck%blocks(i)%name)
@@ -209,8 +212,8 @@ contains
             call read_output(blk, n_options, c%outputs, err)
          case ('NODE OUTPUT', 'ELEMENT OUTPUT', 'ENERGY OUTPUT')
             call read_output_option(blk, model, c%outputs, err)
-         case ('AMPLITUDE')
-            ! defined globally by scene_amplitudes
+         case ('AMPLITUDE', 'TIME POINTS')
+            ! defined globally by scene_amplitudes and scene_time_points
          case ('MPM CONTROLS', 'MPM WALL', 'INFLOW')
             ! material-point keywords: read by scene_mpm
          case default

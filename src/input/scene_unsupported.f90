@@ -44,9 +44,9 @@ contains
          'GAP', 'CONTACT DAMPING', 'CONTACT CONTROLS', 'SURFACE SMOOTHING', 'ADJUST')
        hint = 'constraints and tied/node-based contact are not simulated; bulkflow offers *CONTACT PAIR (and ' // &
             'general *CONTACT) of an element surface with an analytic rigid surface, and *RIGID BODY'
-    case ('NGEN', 'NCOPY', 'NFILL', 'NMAP', 'ELGEN', 'ELCOPY', 'NODAL THICKNESS', 'PARAMETER', 'PARAMETER DEPENDENCE', &
+    case ('NGEN', 'NCOPY', 'NFILL', 'NMAP', 'ELGEN', 'ELCOPY', 'NODAL THICKNESS', &
          'IMPORT', 'MAP SOLUTION', 'INCLUDE FILE', 'SUBMODEL', 'ELEMENT RESPONSE', 'NODE RESPONSE', 'WAVE')
-       hint = 'mesh generation, parameters and imports are not read; write the nodes and elements out ' // &
+       hint = 'mesh generation and imports are not read; write the nodes and elements out ' // &
             '(*NODE, *ELEMENT; *NSET/*ELSET, GENERATE)'
     case ('VARIABLE MASS SCALING', 'CONTROLS', 'SOLUTION TECHNIQUE', 'STEADY STATE CRITERIA', 'ADAPTIVE MESH', &
          'ADAPTIVE MESH CONTROLS', 'ADAPTIVE MESH CONSTRAINT', 'EXTREME VALUE', 'MATRIX OUTPUT', 'ELEMENT MATRIX OUTPUT', &

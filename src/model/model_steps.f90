@@ -71,6 +71,7 @@ module model_steps
      integer :: number_interval = 0
      real(dp) :: time_interval = 0
      integer :: frequency = 0                 !< FREQUENCY=n: every n increments of the step (and its end)
+     real(dp), allocatable :: time_points(:)  !< TIME POINTS=: at these step times exactly (increments cut)
      character(len=8), allocatable :: node_variables(:)     !< U, V, A, RF
      character(len=8), allocatable :: element_variables(:)  !< S, LE, PE, PEEQ, SDV, FV, STATUS
   end type field_output_t
@@ -80,6 +81,7 @@ module model_steps
      real(dp) :: time_interval = 0            !< 0: every increment
      integer :: number_interval = 0
      integer :: frequency = 0                 !< FREQUENCY=n: every n increments of the step (and its end)
+     real(dp), allocatable :: time_points(:)  !< TIME POINTS=: at these step times exactly (increments cut)
      logical :: energies = .false.            !< ALLKE ALLIE ALLVD ALLFD ALLWK ALLAE ETOTAL
      integer :: nset = 0                      !< node set for per-set sums, 0: none
      character(len=8), allocatable :: node_variables(:)     !< e.g. RF1, RF2, U2, V2 summed/averaged over nset

@@ -9,7 +9,10 @@
 !>   TIME INTERVAL=t     the first increment end at or past each multiple of t in step time
 !>   NUMBER INTERVAL=n   the same with t = period/n
 !>   FREQUENCY=n         every n-th increment of the step
-!>   every request       the step's start (step time 0, increment 0) and its end
+!>   TIME POINTS=name    the increment ending on a listed step time (the element driver cuts its
+!>                       increments onto them; such a request is due at the listed times only,
+!>                       not at the step's start and end unless listed)
+!>   every other request the step's start (step time 0, increment 0) and its end
 !> A frame (row) is written after an increment when at least one request of its kind is due:
 !> the union of the requests' times, one frame holding what the step asks for. A step without
 !> a history request writes rows at period/200 (the history default of *OUTPUT); a step without
@@ -33,6 +36,8 @@ module output_schedule
      real(dp), allocatable :: interval(:)     !< step-time interval of a timed request, else 0
      integer, allocatable :: frequency(:)     !< increments between outputs of a FREQUENCY request, else 0
      real(dp), allocatable :: next(:)         !< next step time of a timed request
+     logical, allocatable :: listed(:)        !< a TIME POINTS request (due at its listed times only)
+     real(dp), allocatable :: points(:)       !< the listed step times of all TIME POINTS requests
   end type output_schedule_t
 
   public :: field_schedule, history_schedule, schedule_from_requests, schedule_due, schedule_advance, &
@@ -48,6 +53,7 @@ contains
     if (allocated(step%field_outputs)) then
        call schedule_from_requests(step%period, step%field_outputs%time_interval, &
             step%field_outputs%number_interval, step%field_outputs%frequency, sch)
+       call add_listed_field(step, sch)
     else
        call schedule_from_requests(step%period, [real(dp) ::], [integer ::], [integer ::], sch)
     end if
@@ -62,11 +68,47 @@ contains
        if (size(step%history_outputs) > 0) then
           call schedule_from_requests(step%period, step%history_outputs%time_interval, &
                step%history_outputs%number_interval, step%history_outputs%frequency, sch)
+          call add_listed_history(step, sch)
           return
        end if
     end if
     call schedule_from_requests(step%period, [0.0_dp], [default_history_rows], [0], sch)
   end subroutine history_schedule
+
+  !> The field requests with TIME POINTS= become listed requests.
+  subroutine add_listed_field(step, sch)
+    type(step_t), intent(in) :: step
+    type(output_schedule_t), intent(inout) :: sch
+    integer :: j
+
+    do j = 1, sch%n
+       if (allocated(step%field_outputs(j)%time_points)) &
+            call schedule_list_times(sch, j, step%field_outputs(j)%time_points)
+    end do
+  end subroutine add_listed_field
+
+  !> The history requests with TIME POINTS= become listed requests.
+  subroutine add_listed_history(step, sch)
+    type(step_t), intent(in) :: step
+    type(output_schedule_t), intent(inout) :: sch
+    integer :: j
+
+    do j = 1, sch%n
+       if (allocated(step%history_outputs(j)%time_points)) &
+            call schedule_list_times(sch, j, step%history_outputs(j)%time_points)
+    end do
+  end subroutine add_listed_history
+
+  !> Request j writes at the step times `times` only (TIME POINTS=); an empty list changes nothing.
+  pure subroutine schedule_list_times(sch, j, times)
+    type(output_schedule_t), intent(inout) :: sch
+    integer, intent(in) :: j
+    real(dp), intent(in) :: times(:)
+
+    if (size(times) == 0) return
+    sch%listed(j) = .true.
+    sch%points = [sch%points, times]
+  end subroutine schedule_list_times
 
   !> One schedule per request j: TIME INTERVAL time_interval(j) > 0, else NUMBER INTERVAL
   !> number_interval(j) > 0, else FREQUENCY frequency(j) > 0; a request with none of them is
@@ -80,7 +122,8 @@ contains
 
     sch%n = size(time_interval)
     sch%period = period
-    allocate (sch%interval(sch%n), sch%frequency(sch%n), sch%next(sch%n))
+    allocate (sch%interval(sch%n), sch%frequency(sch%n), sch%next(sch%n), sch%listed(sch%n), sch%points(0))
+    sch%listed = .false.
     do j = 1, sch%n
        sch%interval(j) = 0
        sch%frequency(j) = 0
@@ -101,19 +144,29 @@ contains
     type(output_schedule_t), intent(in) :: sch
     real(dp), intent(in) :: step_time, dt
     integer, intent(in) :: step_increment
+    real(dp) :: t_prev, tol
+    logical :: boundary
     integer :: j
 
     due = .false.
     if (sch%n == 0) return
-    due = step_increment == 0 .or. step_time >= sch%period * (1 - 1.0e-12_dp)
+    boundary = step_increment == 0 .or. step_time >= sch%period * (1 - 1.0e-12_dp)
     do j = 1, sch%n
-       if (due) return
-       if (sch%interval(j) > 0) then
+       if (sch%listed(j)) cycle
+       if (boundary) then
+          due = .true.
+       else if (sch%interval(j) > 0) then
           due = step_time >= sch%next(j) - 1.0e-9_dp * max(sch%period, dt)
        else
           due = mod(step_increment, sch%frequency(j)) == 0
        end if
+       if (due) return
     end do
+    if (size(sch%points) == 0) return
+    ! a listed time in (t_prev, t] (at the step's start: t itself), within 1e-9·period
+    tol = 1.0e-9_dp * sch%period
+    t_prev = merge(-huge(1.0_dp), step_time - dt, step_increment == 0)
+    due = any(sch%points > t_prev + tol .and. sch%points <= step_time + tol)
   end function schedule_due
 
   !> After an output at step time `step_time`: every timed request's next time past it.

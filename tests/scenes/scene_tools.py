@@ -73,6 +73,22 @@ class Launcher:
 # ---------------------------------------------------------------------------------------------
 # Scene parameters
 
+def run_deck(bulkflow: str, deck: Path, base: Path) -> str:
+    """Run a deck to completion (outputs BASE.h5, BASE_history.csv); stop the check if it fails."""
+    p = subprocess.run([bulkflow, str(deck), '--output', str(base)], capture_output=True, text=True, timeout=300)
+    if p.returncode != 0:
+        raise SystemExit(f'FAIL: {deck.name} exited {p.returncode}:\n{p.stdout}\n{p.stderr}')
+    return p.stdout
+
+
+def verify_deck(bulkflow: str, deck: Path, workdir: Path) -> bool:
+    """check_scene.py verify on a deck written by a test (its '** verify:' lines), output printed."""
+    p = subprocess.run([sys.executable, str(Path(__file__).parent / 'check_scene.py'), 'verify', str(deck),
+                        '--bulkflow', bulkflow, '--workdir', str(workdir)], capture_output=True, text=True, timeout=300)
+    print(p.stdout.rstrip())
+    return p.returncode == 0
+
+
 def scene_parameters(path: Path) -> dict[str, str]:
     """The `** verify: key = value` lines of a scene (written by make_verification_scenes.py)."""
     params = {}
