@@ -6,7 +6,7 @@
 module parameter_arithmetic
   use, intrinsic :: iso_fortran_env, only: int64
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   implicit none
   private
 

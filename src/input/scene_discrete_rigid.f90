@@ -12,7 +12,7 @@
 !> chain (open, or closed: then it starts and ends at the same node). 3D rigid elements (R3D3,
 !> R3D4) are refused (not done).
 module scene_discrete_rigid
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t, set_line_text, &
        reparse_keyword_line, is_integer_text

@@ -4,7 +4,7 @@
 !> (model or history data, as in Abaqus) before the steps, each checked at its line: times >= 0,
 !> strictly increasing; GENERATE lines are `start, end, increment` (increment > 0, end >= start).
 module scene_time_points
-  use material_kinds, only: dp
+  use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t
   use scene_util, only: itoa, rtoa, get_real, where_text
