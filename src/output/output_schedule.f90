@@ -41,7 +41,7 @@ module output_schedule
   end type output_schedule_t
 
   public :: field_schedule, history_schedule, schedule_from_requests, schedule_due, schedule_advance, &
-       schedule_resume
+       schedule_resume, schedule_list_times
 
 contains
 
@@ -49,11 +49,15 @@ contains
   subroutine field_schedule(step, sch)
     type(step_t), intent(in) :: step
     type(output_schedule_t), intent(out) :: sch
+    integer :: j
 
     if (allocated(step%field_outputs)) then
        call schedule_from_requests(step%period, step%field_outputs%time_interval, &
             step%field_outputs%number_interval, step%field_outputs%frequency, sch)
-       call add_listed_field(step, sch)
+       do j = 1, sch%n   ! TIME POINTS= requests
+          if (allocated(step%field_outputs(j)%time_points)) &
+               call schedule_list_times(sch, j, step%field_outputs(j)%time_points)
+       end do
     else
        call schedule_from_requests(step%period, [real(dp) ::], [integer ::], [integer ::], sch)
     end if
@@ -63,41 +67,21 @@ contains
   subroutine history_schedule(step, sch)
     type(step_t), intent(in) :: step
     type(output_schedule_t), intent(out) :: sch
+    integer :: j
 
     if (allocated(step%history_outputs)) then
        if (size(step%history_outputs) > 0) then
           call schedule_from_requests(step%period, step%history_outputs%time_interval, &
                step%history_outputs%number_interval, step%history_outputs%frequency, sch)
-          call add_listed_history(step, sch)
+          do j = 1, sch%n   ! TIME POINTS= requests
+             if (allocated(step%history_outputs(j)%time_points)) &
+                  call schedule_list_times(sch, j, step%history_outputs(j)%time_points)
+          end do
           return
        end if
     end if
     call schedule_from_requests(step%period, [0.0_dp], [default_history_rows], [0], sch)
   end subroutine history_schedule
-
-  !> The field requests with TIME POINTS= become listed requests.
-  subroutine add_listed_field(step, sch)
-    type(step_t), intent(in) :: step
-    type(output_schedule_t), intent(inout) :: sch
-    integer :: j
-
-    do j = 1, sch%n
-       if (allocated(step%field_outputs(j)%time_points)) &
-            call schedule_list_times(sch, j, step%field_outputs(j)%time_points)
-    end do
-  end subroutine add_listed_field
-
-  !> The history requests with TIME POINTS= become listed requests.
-  subroutine add_listed_history(step, sch)
-    type(step_t), intent(in) :: step
-    type(output_schedule_t), intent(inout) :: sch
-    integer :: j
-
-    do j = 1, sch%n
-       if (allocated(step%history_outputs(j)%time_points)) &
-            call schedule_list_times(sch, j, step%history_outputs(j)%time_points)
-    end do
-  end subroutine add_listed_history
 
   !> Request j writes at the step times `times` only (TIME POINTS=); an empty list changes nothing.
   pure subroutine schedule_list_times(sch, j, times)
