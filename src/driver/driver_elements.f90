@@ -340,7 +340,10 @@ contains
           w%stretch_new(1:nb, 3) = w%hoop_stretch
        end if
        call centroids(nb, nd, ne, w%xe_old, w%du, w%vumat%coord)
-       ! *INITIAL CONDITIONS, TYPE=TEMPERATURE and the step's *TEMPERATURE at t_n and t_n+1
+    end if
+    ! *INITIAL CONDITIONS, TYPE=TEMPERATURE and the step's *TEMPERATURE at t_n and t_n+1, for a
+    ! user's VUMAT (tempOld, tempNew) and a user's VUSDFLD (vgetvrm('TEMP')); ours ignore it.
+    if (blk%vumat_needs_kinematics .or. m%materials(blk%material)%user_field_code) then
        call element_temperatures(m, solver, blk, solver%step_time, solver%total_time, w%vumat%temp(1:nb))
        call element_temperatures(m, solver, blk, solver%step_time + dt, solver%total_time + dt, &
             w%vumat%temp_new(1:nb))

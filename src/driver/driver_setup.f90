@@ -111,7 +111,7 @@ contains
     if (allocated(m%initial_fields)) then
        ! Element value = mean of its nodes' values (nodes without a value count as 0). Our models
        ! read field 1 with our user field only; a user's VUMAT gets every field and the
-       ! temperature, a user's VUSDFLD every field.
+       ! temperature, a user's VUSDFLD every field and the temperature (vgetvrm).
        do ib = 1, solver%n_blocks
           associate (blk => solver%blocks(ib), mat => m%materials(solver%blocks(ib)%material))
             do e = 1, blk%count
@@ -122,7 +122,9 @@ contains
                      blk%field(e, k) = mean_initial_field(m, g, k)
                   end do
                else if (mat%user_field_code) then
-                  ! a user's VUSDFLD on one of our models: every field it is given
+                  ! a user's VUSDFLD on one of our models: every field it is given, and the
+                  ! temperature for vgetvrm('TEMP')
+                  blk%temp(e) = mean_initial_field(m, g, 0)
                   do k = 1, mat%nfieldv
                      blk%field(e, k) = mean_initial_field(m, g, k)
                   end do

@@ -199,6 +199,29 @@ contains
     end associate
   end subroutine check_our_field_props
 
+  !> The state variables of a built-in plastic model: our VUMAT's n_state_plastic first. Our own
+  !> VUSDFLD shares them (*DEPVAR forced to at least n_state_plastic, its flow-function record in
+  !> the last); a user's VUSDFLD gets the *DEPVAR ones only, as in Abaqus, after ours.
+  subroutine model_state_first(m)
+    type(material_t), intent(inout) :: m
+
+    character(len=len(m%name)), allocatable :: names(:)
+
+    if (m%user_field_code) then
+       m%user_state_first = n_state_plastic + 1
+       m%nstatev = n_state_plastic + m%nstatev
+       if (allocated(m%sdv_names)) then
+          ! names from *DEPVAR lines belong to the user's state variables, after ours
+          allocate (names(m%nstatev))
+          names = ''
+          names(m%user_state_first:) = m%sdv_names
+          call move_alloc(names, m%sdv_names)
+       end if
+    else
+       m%nstatev = max(m%nstatev, n_state_plastic)
+    end if
+  end subroutine model_state_first
+
   !> 0 or 1 exactly.
   pure logical function is_flag(x)
     real(dp), intent(in) :: x
@@ -360,7 +383,7 @@ contains
     if (n_ff > 0) p(k + 1:k + 2 * n_ff) = reshape(mat%flow_table, [2 * n_ff])
     m%vumat_name = 'MC-' // trim(mat%name)
     call move_alloc(p, m%props)
-    m%nstatev = max(m%nstatev, n_state_plastic)
+    call model_state_first(m)
     if (n_ang > 0 .or. on_field) then
        ! the tables run on field 1, which our VUSDFLD sets: the volumetric strain, or with
        ! *USER DEFINED FIELD, PROPERTIES=3 (1, t_freeze, record) the consolidation stress
@@ -412,7 +435,7 @@ contains
     end if
     m%vumat_name = 'DP-' // trim(mat%name)
     m%props = [mat%young, mat%poisson, mat%beta, mat%psi_dp, d, 0.0_dp]
-    m%nstatev = max(m%nstatev, n_state_plastic)
+    call model_state_first(m)
     call final_check(deck%blocks(mat%option_block(opt_drucker_prager)), m, err)
   end subroutine translate_drucker_prager
 

@@ -4,11 +4,12 @@
 !> which block is current: `host_set_block` copies its start-of-increment stress and
 !> logarithmic strain (VUMAT layout, `(nblock, ncomp)`), and `host_set_block_extra` its state
 !> variables, temperature and, for our plastic models, plastic strain and PEEQ, and
-!> `host_set_block_moduli` the material's isotropic moduli (PE = LE − C⁻¹:σ for any material); the external
-!> `vgetvrm` reads them back in Abaqus's flat layout (docs/user_subroutines.md lists the keys).
-!> A key whose values the current block does not have is an error that names the key and the
-!> keys the block has (`host_available_keys`): user code that ignores jStatus would otherwise
-!> read whatever its buffer held.
+!> `host_set_block_moduli` the material's isotropic moduli (PE = LE − C⁻¹:σ for any material),
+!> `host_set_block_material` whose block it is (messages); the external `vgetvrm` reads them back
+!> in Abaqus's flat layout (docs/user_subroutines.md lists the keys).
+!> A key whose values the current block does not have is an error that names the key, the
+!> material and the keys the block has (`host_available_keys`): user code that ignores jStatus
+!> would otherwise read whatever its buffer held.
 !> `host_set_job` records what vgetjobname, vgetoutdir, vgetrank and vgetnumcpus answer.
 !> `host_set_exit_handler` lets the application decide how `xplb_exit` ends the run (plain
 !> exit, or MPI_Abort in the parallel solver).
@@ -28,6 +29,9 @@ module abaqus_host
   integer :: block_size = 0, block_components = 0
   !> Isotropic moduli λ, G of the current block's material (packaging call); < 0: not known.
   real(dp) :: block_lambda = -1, block_shear = -1
+  !> The current block's material (its scene name) and whether the user's VUMAT computes it.
+  character(len=:), allocatable :: block_material
+  logical :: block_user_vumat = .false.
   procedure(exit_handler), pointer :: on_exit => null()
   character(len=:), allocatable :: job_name, output_dir
   integer :: job_rank = 0, job_ranks = 1
@@ -35,7 +39,7 @@ module abaqus_host
   public :: exit_handler
   public :: host_set_block, host_set_block_extra, host_set_block_moduli, host_get_variable
   public :: host_set_exit_handler, host_exit
-  public :: host_available_keys
+  public :: host_available_keys, host_set_block_material, host_block_material, host_missing_key_note
   public :: host_set_job, host_job_name, host_output_dir, host_rank, host_ranks
 
 contains
@@ -61,6 +65,39 @@ contains
     block_lambda = -1
     block_shear = -1
   end subroutine host_set_block
+
+  !> The current block's material (its name in the scene) and whether a user's VUMAT computes it
+  !> (then the host keeps no equivalent plastic strain for it).
+  subroutine host_set_block_material(name, user_vumat)
+    character(len=*), intent(in) :: name
+    logical, intent(in) :: user_vumat
+    block_material = trim(name)
+    block_user_vumat = user_vumat
+  end subroutine host_set_block_material
+
+  function host_block_material() result(name)
+    character(len=:), allocatable :: name
+    name = '(unknown)'
+    if (allocated(block_material)) name = block_material
+  end function host_block_material
+
+  !> Why the current block has no `key` (for vgetvrm's error), '' when there is nothing to add.
+  !> PEEQ: Abaqus keeps an equivalent plastic strain only for its own plasticity models (a user
+  !> material's inelastic history lives in its state variables, *Abaqus Analysis User's Guide*,
+  !> "User-defined mechanical material behavior"); so does bulkflow.
+  function host_missing_key_note(key) result(note)
+    character(len=*), intent(in) :: key
+    character(len=:), allocatable :: note
+
+    note = ''
+    if (trim(adjustl(key)) /= 'PEEQ') return
+    if (block_user_vumat) then
+       note = '; PEEQ exists only for built-in plasticity: a user VUMAT keeps its equivalent plastic ' // &
+            'strain in a state variable (read it with vgetvrm(''SDV''))'
+    else
+       note = '; PEEQ exists only for plastic materials (our Mohr-Coulomb and Drucker-Prager)'
+    end if
+  end function host_missing_key_note
 
   !> The isotropic elastic moduli of the current block's material (its packaging call): with them
   !> vgetvrm('PE') answers LE − C⁻¹:σ when the block keeps no plastic strain of its own.

@@ -7,13 +7,14 @@
 
 !> Start-of-increment values of an output variable for the current block.
 !> Keys: S, LE, SDV, TEMP, PE (LE − C⁻¹:σ with the packaging call's moduli) and PEEQ for our
-!> plastic models. Any other key, or PEEQ for a material that has none (a user's VUMAT), stops
-!> the run naming the key (exit 2): Abaqus
-!> returns jStatus /= 0, but user code that does not test it would go on with stale data.
+!> plastic models. Any other key, or PEEQ for a material that has none (a user's VUMAT, our
+!> elastic model), stops the run naming the key and the material (exit 2): Abaqus returns
+!> jStatus /= 0, but user code that does not test it would go on with stale data.
 subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
   use, intrinsic :: iso_fortran_env, only: error_unit
   use base_kinds, only: dp
-  use abaqus_host, only: host_get_variable, host_available_keys, host_exit
+  use abaqus_host, only: host_get_variable, host_available_keys, host_exit, host_block_material, &
+       host_missing_key_note
   implicit none
   character(len=*), intent(in) :: cVar
   real(dp), intent(out) :: rData(*)
@@ -26,8 +27,8 @@ subroutine vgetvrm(cVar, rData, jData, cData, jStatus)
   call host_get_variable(cVar, rData, jStatus)
   if (jStatus /= 0) then
      write (error_unit, '(a)') "bulkflow: error: user subroutine called vgetvrm('" // trim(adjustl(cVar)) // &
-          "'): output variable not available for this material; it provides " // host_available_keys() // &
-          ' (PEEQ only for our plastic models, a user VUMAT keeps none)'
+          "') for material " // host_block_material() // ': output variable not available; this material ' // &
+          'provides ' // host_available_keys() // host_missing_key_note(cVar)
      call host_exit(2)
   end if
 end subroutine vgetvrm

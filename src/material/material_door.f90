@@ -22,7 +22,8 @@
 module material_door
   use base_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use abaqus_host, only: host_set_block, host_set_block_extra, host_set_block_moduli
+  use abaqus_host, only: host_set_block, host_set_block_extra, host_set_block_moduli, host_set_block_material
+  use material_props, only: model_from_name, model_mohr_coulomb, model_drucker_prager
   use model_materials, only: material_t
   use model_sets, only: name_length
   use material_entry, only: vumat_entry, vusdfld_entry
@@ -101,9 +102,8 @@ contains
     ! Allocatable for the same reason as stress and state.
     real(dp), allocatable, intent(inout) :: e_int(:), e_inel(:)
     type(vumat_work_t), intent(inout) :: w
-    integer :: nstatev, nfieldv, nprops, ns, nf
-    real(dp) :: lambda, shear
-    procedure(), pointer :: umat, usdfld
+    integer :: nstatev, nfieldv, nprops, ns, nf, piece, i0
+    procedure(), pointer :: umat
 
     if (mat%user_code) then
        call call_user_material(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, char_length, &
@@ -112,7 +112,6 @@ contains
        return
     end if
     umat => vumat_entry(.false.)
-    usdfld => vusdfld_entry(mat%user_field_code)
     nstatev = mat%nstatev
     nfieldv = mat%nfieldv
     nprops = size(mat%props)
@@ -126,21 +125,15 @@ contains
     w%jblock(1:4) = [nb, 1, 1, 1]
     w%jblock(5:4 + nb) = elem_number
     if (mat%user_field) then
-       call elastic_moduli(mat, ncomp, nshr, lambda, shear)
-       call host_set_block(nb, ncomp, stress, log_strain(1:nb, :))
-       call host_set_block_extra(state(1:nb, 1:ns), w%temp(1:nb), peeq=state(1:nb, 1))
-       call host_set_block_moduli(lambda, shear)
+       ! A user's VUSDFLD gets at most n_vec_length points a call (Abaqus's nblock), ours the
+       ! whole block; each point's answer depends on that point alone.
        w%field_new(1:nb, 1:nfieldv) = field(1:nb, 1:nfieldv)
-       if (allocated(mat%field_props)) then
-          call usdfld(nb, nstatev, nfieldv, size(mat%field_props), 3, nshr, elem_number, 1, 1, 1, step_time, &
-               total_time, dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), &
-               char_length, mat%field_props, state(1:nb, 1:ns), w%state_mid(1:nb, 1:ns), &
-               w%field_new(1:nb, 1:nfieldv))
-       else
-          call usdfld(nb, nstatev, nfieldv, nprops, 3, nshr, elem_number, 1, 1, 1, step_time, total_time, &
-               dt, mat%vumat_name, w%coord(1:nb, :), w%direct(1:nb, :, :), w%direct(1:nb, :, :), char_length, &
-               mat%props, state(1:nb, 1:ns), w%state_mid(1:nb, 1:ns), w%field_new(1:nb, 1:nfieldv))
-       end if
+       piece = nb
+       if (mat%user_field_code) piece = n_vec_length
+       do i0 = 1, nb, piece
+          call call_field_piece(mat, i0, min(nb, i0 + piece - 1), i0, ncomp, nshr, elem_number, step_time, &
+               total_time, dt, char_length, stress, log_strain, state(1:nb, 1:ns), w)
+       end do
        call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
             mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
             w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, w%state_mid(1:nb, 1:ns), &
@@ -184,12 +177,10 @@ contains
     real(dp), intent(in) :: log_strain(:, :)
     real(dp), intent(inout) :: stress(:, :), state(:, :), field(:, :), e_int(:), e_inel(:)
     type(vumat_work_t), intent(inout) :: w
-    procedure(), pointer :: umat, usdfld
+    procedure(), pointer :: umat
     integer :: nstatev, nfieldv, nprops, ns, nf, i0, i1, n
-    real(dp) :: lambda, shear
 
     umat => vumat_entry(.true.)
-    usdfld => vusdfld_entry(mat%user_field_code)
     nstatev = mat%nstatev
     nfieldv = mat%nfieldv
     nprops = size(mat%props)
@@ -205,23 +196,8 @@ contains
        w%field_new(1:n, 1:nf) = field(i0:i1, 1:nf)
        w%e_int_new(1:n) = e_int(i0:i1)
        w%e_inel_new(1:n) = e_inel(i0:i1)
-       if (mat%user_field) then
-          call elastic_moduli(mat, ncomp, nshr, lambda, shear)
-          call host_set_block(n, ncomp, stress(i0:i1, :), log_strain(i0:i1, :))
-          call host_set_block_extra(state(i0:i1, 1:ns), w%temp(i0:i1))
-          call host_set_block_moduli(lambda, shear)
-          if (allocated(mat%field_props)) then
-             call usdfld(n, nstatev, nfieldv, size(mat%field_props), 3, nshr, elem_number(i0:i1), 1, 1, 1, &
-                  step_time, total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), &
-                  w%direct(1:n, :, :), char_length(i0:i1), mat%field_props, state(i0:i1, 1:ns), &
-                  w%state_mid(1:n, 1:ns), w%field_new(1:n, 1:nfieldv))
-          else
-             call usdfld(n, nstatev, nfieldv, nprops, 3, nshr, elem_number(i0:i1), 1, 1, 1, step_time, &
-                  total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), w%direct(1:n, :, :), &
-                  char_length(i0:i1), mat%props, state(i0:i1, 1:ns), w%state_mid(1:n, 1:ns), &
-                  w%field_new(1:n, 1:nfieldv))
-          end if
-       end if
+       if (mat%user_field) call call_field_piece(mat, i0, i1, 1, ncomp, nshr, elem_number, step_time, &
+            total_time, dt, char_length, stress, log_strain, state(:, 1:ns), w)
        w%state_new(1:n, 1:ns) = w%state_mid(1:n, 1:ns)
        call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
             mat%vumat_name, w%coord(i0:i1, :), char_length(i0:i1), mat%props, density(i0:i1), &
@@ -238,6 +214,56 @@ contains
        e_inel(i0:i1) = w%e_inel_new(1:n)
     end do
   end subroutine call_user_material
+
+  !> The material's VUSDFLD on the points i0..i1 of a block: the host's vgetvrm data for those
+  !> points (start-of-increment S, LE, SDV, TEMP, PE from the packaging moduli and, for our
+  !> plastic models, PEEQ = SDV1), then the call, whose stateNew and field land in rows
+  !> first.. of w%state_mid and w%field_new (fieldNew holding its old values on entry). A user's
+  !> VUSDFLD on our plastic models gets the *DEPVAR state variables only (user_state_first).
+  subroutine call_field_piece(mat, i0, i1, first, ncomp, nshr, elem_number, step_time, total_time, dt, &
+       char_length, stress, log_strain, state, w)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: i0, i1, first, ncomp, nshr
+    integer, intent(in) :: elem_number(:)
+    real(dp), intent(in) :: step_time, total_time, dt
+    real(dp), intent(in) :: char_length(:), stress(:, :), log_strain(:, :), state(:, :)
+    type(vumat_work_t), intent(inout) :: w
+    procedure(), pointer :: usdfld
+    integer :: n, last, ns, nf, model, j0, nsu
+    real(dp) :: lambda, shear
+
+    usdfld => vusdfld_entry(mat%user_field_code)
+    n = i1 - i0 + 1
+    last = first + n - 1
+    ns = size(state, 2)
+    nf = mat%nfieldv
+    ! A user's VUSDFLD sees SDV j0..nstatev (on our plastic models the *DEPVAR ones after our
+    ! model's own) and may leave stateNew alone: it holds stateOld on entry.
+    j0 = mat%user_state_first
+    nsu = mat%nstatev - j0 + 1
+    if (mat%user_field_code) w%state_mid(first:last, 1:ns) = state(i0:i1, :)
+    call elastic_moduli(mat, ncomp, nshr, lambda, shear)
+    call host_set_block(n, ncomp, stress(i0:i1, :), log_strain(i0:i1, :))
+    model = model_from_name(mat%vumat_name)
+    if (.not. mat%user_code .and. (model == model_mohr_coulomb .or. model == model_drucker_prager)) then
+       call host_set_block_extra(state(i0:i1, j0:j0 + nsu - 1), w%temp(i0:i1), peeq=state(i0:i1, 1))
+    else
+       call host_set_block_extra(state(i0:i1, j0:j0 + nsu - 1), w%temp(i0:i1))
+    end if
+    call host_set_block_moduli(lambda, shear)
+    call host_set_block_material(mat%name, mat%user_code)
+    if (allocated(mat%field_props)) then
+       call usdfld(n, nsu, nf, size(mat%field_props), 3, nshr, elem_number(i0:i1), 1, 1, 1, &
+            step_time, total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), &
+            w%direct(1:n, :, :), char_length(i0:i1), mat%field_props, state(i0:i1, j0:ns), &
+            w%state_mid(first:last, j0:ns), w%field_new(first:last, 1:nf))
+    else
+       call usdfld(n, nsu, nf, size(mat%props), 3, nshr, elem_number(i0:i1), 1, 1, 1, step_time, &
+            total_time, dt, mat%vumat_name, w%coord(i0:i1, :), w%direct(1:n, :, :), w%direct(1:n, :, :), &
+            char_length(i0:i1), mat%props, state(i0:i1, j0:ns), w%state_mid(first:last, j0:ns), &
+            w%field_new(first:last, 1:nf))
+    end if
+  end subroutine call_field_piece
 
   !> Stop with the material, the element or particle and the time when a user's VUMAT returned
   !> a stress that is not a finite number (it would spread through the mesh as NaN).

@@ -4,7 +4,8 @@
 !> call_material answers them all with the same Abaqus argument contract as elements and
 !> particles: element number 1, coordMp 0, charLength 1, no rotation (relSpinInc = 0), stretch
 !> and F from the logarithmic strain (material_kinematics), the current density ρ0 exp(−tr ε)
-!> at mid-increment, the input's temperature as tempOld and tempNew.
+!> at mid-increment, the path's temperature at the increment's start and end as tempOld and
+!> tempNew (set_temperature).
 module matpoint_block
   use base_kinds, only: dp
   use model_materials, only: material_t
@@ -28,6 +29,7 @@ module matpoint_block
    contains
      procedure :: init => block_init
      procedure :: set_point => block_set_point
+     procedure :: set_temperature => block_set_temperature
      procedure :: call_material => block_call_material
   end type point_block_t
 
@@ -65,6 +67,16 @@ contains
     self%work%temp = temperature
     self%work%temp_new = temperature
   end subroutine block_init
+
+  !> tempOld and tempNew of every point of the block (the temperature at the increment's start
+  !> and end).
+  subroutine block_set_temperature(self, temp_old, temp_new)
+    class(point_block_t), intent(inout) :: self
+    real(dp), intent(in) :: temp_old, temp_new
+
+    self%work%temp(1:self%nblock) = temp_old
+    self%work%temp_new(1:self%nblock) = temp_new
+  end subroutine block_set_temperature
 
   !> Load point `k` with an old state and a strain increment.
   subroutine block_set_point(self, k, density0, log_strain, strain_inc, stress, state, field, &

@@ -13,7 +13,11 @@
 !>   *INITIAL CONDITIONS, TYPE=STRESS    data: s11, s22, s33, s12[, s23, s31] (VUMAT order)
 !>   *INITIAL CONDITIONS, TYPE=SOLUTION  data: SDV1, SDV2, ...
 !>   *INITIAL CONDITIONS, TYPE=FIELD, VARIABLE=i   data: value of field i
-!>   *INITIAL CONDITIONS, TYPE=TEMPERATURE         data: the temperature (tempOld = tempNew)
+!>   *INITIAL CONDITIONS, TYPE=TEMPERATURE         data: the initial temperature
+!>   *AMPLITUDE, NAME=a [, DEFINITION=, TIME=]      as in a scene (scene_amplitudes)
+!>   *TEMPERATURE [, AMPLITUDE=a] [, OP=MOD|NEW]    data: "material name, value" as in an MPM
+!>                                   scene (scene_temperature): T(t) = value × a(t), tempOld at
+!>                                   the increment's start, tempNew at its end
 !>   *TEST, TYPE=t [, DIMENSION=2|3] [, AXIS=1|2|3]
 !>   *STAGE, INC=n [, TIME=t] [, STRAIN=x] [, STRESS=s]   (GENERAL: data "comp, STRAIN|STRESS|HOLD, value")
 !>   *DRIVER CONTROLS [, TOLERANCE=tol] [, ITERATIONS=n]
@@ -22,10 +26,12 @@ module matpoint_input
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_deck_t, keyword_block_t, read_keyword_file, &
        read_keyword_string, upper_case
-  use model, only: model_t
   use model_materials, only: material_t
   use scene_layout, only: is_material_option
   use scene_materials, only: build_deck_materials
+  use scene_amplitudes, only: build_amplitudes
+  use scene_temperature, only: read_temperature
+  use model_steps, only: temperature_t
   use user_library, only: user_library_loaded
   use matpoint_path, only: matpoint_path_t, matpoint_stage_t, max_components, control_strain, &
        control_stress, control_stress_hold, test_general, test_triaxial, test_biaxial, &
@@ -36,11 +42,11 @@ module matpoint_input
 
   public :: build_matpoint_input, read_matpoint_file, read_matpoint_string
 
-  character(len=24), parameter :: known_keywords(18) = [character(len=24) :: &
+  character(len=24), parameter :: known_keywords(20) = [character(len=24) :: &
        'HEADING', 'MATERIAL', 'DENSITY', 'ELASTIC', 'MOHR COULOMB', 'MOHR COULOMB HARDENING', &
        'TENSION CUTOFF', 'FLOW FUNCTION', 'DRUCKER PRAGER', 'DRUCKER PRAGER HARDENING', &
        'USER MATERIAL', 'DEPVAR', 'USER DEFINED FIELD', 'INITIAL CONDITIONS', 'TEST', 'STAGE', &
-       'DRIVER CONTROLS', 'INCLUDE']
+       'DRIVER CONTROLS', 'AMPLITUDE', 'TEMPERATURE', 'INCLUDE']
 
   !> What has been seen so far (for order and completeness checks).
   type :: build_state_t
@@ -128,6 +134,8 @@ contains
                call read_stage(blk, path, st, local)
             case ('DRIVER CONTROLS')
                call read_controls(blk, path, local)
+            case ('AMPLITUDE', 'TEMPERATURE')
+               ! read once the material is known (read_predefined_temperature)
             case default
                call blk%fail('unknown keyword *' // blk%name // ' (the material-point driver ' // &
                     'knows ' // keyword_list() // ')', local)
@@ -136,7 +144,8 @@ contains
        end associate
        if (local%raised) exit
     end do
-    if (.not. local%raised) call read_point_material(deck, st, mat, local)
+    if (.not. local%raised) call read_point_material(deck, st, mat, path, local)
+    if (.not. local%raised) call read_predefined_temperature(deck, path, local)
     if (.not. local%raised) call final_checks(deck, mat, path, st, local)
     if (local%raised) call raise_error('', 0, local%message, err)
     if (present(title)) title = t
@@ -185,22 +194,51 @@ contains
   end subroutine expect_lines
 
   !> The one *MATERIAL and its options, read as a scene's (scene_materials): with a user file
-  !> loaded (--user, or linked into bulkflow-matpoint-user) a *USER MATERIAL is the user's.
-  subroutine read_point_material(deck, st, mat, err)
+  !> loaded (--user, or linked into bulkflow-matpoint-user) a *USER MATERIAL is the user's. The
+  !> scene the reader built is kept in path%predefined (its temperature in time).
+  subroutine read_point_material(deck, st, mat, path, err)
     type(keyword_deck_t), intent(in) :: deck
     type(build_state_t), intent(in) :: st
     type(material_t), intent(out) :: mat
+    type(matpoint_path_t), intent(inout) :: path
     type(error_t), intent(inout) :: err
-    type(model_t) :: materials
 
     if (st%material_block == 0) then
        call raise_error(deck_file(deck), 0, 'no *MATERIAL in the input', err)
        return
     end if
-    call build_deck_materials(deck, materials, user_library_loaded(), err)
+    call build_deck_materials(deck, path%predefined, user_library_loaded(), err)
     if (err%raised) return
-    mat = materials%materials(1)
+    mat = path%predefined%materials(1)
   end subroutine read_point_material
+
+  !> *AMPLITUDE and *TEMPERATURE read by the scene reader into path%predefined as an MPM scene
+  !> holds them (no mesh: *TEMPERATURE names the material), the whole path being one step; the
+  !> initial temperature is the material's *INITIAL CONDITIONS, TYPE=TEMPERATURE.
+  subroutine read_predefined_temperature(deck, path, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(matpoint_path_t), intent(inout) :: path
+    type(error_t), intent(inout) :: err
+    type(temperature_t), allocatable :: active(:)
+    integer :: b, n
+
+    call build_amplitudes(deck, path%predefined, err)
+    if (err%raised) return
+    n = 0
+    allocate (active(0))
+    do b = 1, deck%n_blocks
+       if (deck%blocks(b)%name /= 'TEMPERATURE') cycle
+       call read_temperature(deck%blocks(b), path%predefined, active, n, err)
+       if (err%raised) return
+    end do
+    allocate (path%predefined%steps(1), path%predefined%initial_fields(1))
+    path%predefined%n_steps = 1
+    path%predefined%steps(1)%temperatures = active(1:n)
+    path%predefined%initial_fields(1)%material = 1
+    path%predefined%initial_fields(1)%variable = 0
+    path%predefined%initial_fields(1)%value = path%temperature
+    allocate (path%predefined%initial_fields(1)%nodes(0))
+  end subroutine read_predefined_temperature
 
   function deck_file(deck) result(file)
     type(keyword_deck_t), intent(in) :: deck

@@ -12,6 +12,8 @@
 !> whose out-of-plane direction is 3). Stresses are in the Abaqus sign (tension positive).
 module matpoint_path
   use base_kinds, only: dp
+  use model, only: model_t
+  use model_particle_fields, only: particle_temperature
   implicit none
   private
 
@@ -52,7 +54,11 @@ module matpoint_path
      real(dp) :: initial_stress(max_components) = 0.0_dp
      real(dp), allocatable :: initial_state(:)   !< first SDVs (rest zero)
      real(dp), allocatable :: initial_field(:)   !< first field variables (rest zero)
-     real(dp) :: temperature = 0.0_dp            !< tempOld = tempNew of every call
+     real(dp) :: temperature = 0.0_dp            !< *INITIAL CONDITIONS, TYPE=TEMPERATURE
+     !> The predefined temperature in time, as a material-point (MPM) scene holds it: the one
+     !> material, the *AMPLITUDE curves, one step whose *TEMPERATURE entries name the material,
+     !> and the initial temperature; evaluated by the scene's own code (temperature_at).
+     type(model_t) :: predefined
      integer :: n_stages = 0
      type(matpoint_stage_t), allocatable :: stages(:)
      real(dp) :: tolerance = 1.0e-12_dp      !< mixed control: relative to the stress scale
@@ -61,6 +67,7 @@ module matpoint_path
      procedure :: ncomp => path_ncomp
      procedure :: add_stage => path_add_stage
      procedure :: lateral => path_lateral
+     procedure :: temperature_at => path_temperature_at
   end type matpoint_path_t
 
   public :: component_label, test_from_name, default_dimension, preset_stage
@@ -79,6 +86,18 @@ contains
 
     path_lateral = merge(2, 1, self%axis == 1)
   end function path_lateral
+
+  !> The point's temperature at time t of the path (one Abaqus step: step time = total time):
+  !> the last *TEMPERATURE entry, value × a(t), else the initial temperature
+  !> (model_particle_fields, the MPM scenes' evaluation).
+  real(dp) function path_temperature_at(self, t) result(temp)
+    class(matpoint_path_t), intent(in) :: self
+    real(dp), intent(in) :: t
+
+    temp = self%temperature
+    if (.not. allocated(self%predefined%steps)) return
+    temp = particle_temperature(self%predefined, 1, 1, t, t)
+  end function path_temperature_at
 
   subroutine path_add_stage(self, stage)
     class(matpoint_path_t), intent(inout) :: self

@@ -325,6 +325,7 @@ contains
           call blk%set_point(1 + j, mat%density, pt%strain, de_k, pt%stress, pt%state, &
                pt%field, pt%ener_intern, pt%ener_inelas)
        end do
+       call blk%set_temperature(path%temperature_at(pt%time), path%temperature_at(t_new))
        call blk%call_material(mat, t_new, dt)
        if (.not. all_finite(blk%stress)) then
           call raise_error('', 0, 'the VUMAT returned a non-finite stress', err)

@@ -22,6 +22,10 @@ module model_materials
      real(dp) :: density = 0
      real(dp), allocatable :: props(:)
      integer :: nstatev = 0                      !< *DEPVAR
+     !> The first state variable a user's VUSDFLD sees: 1, except on our built-in plastic models,
+     !> whose own SDVs come first (umat/README.md) and are not the VUSDFLD's (Abaqus gives it the
+     !> *DEPVAR ones only: SDV first..nstatev).
+     integer :: user_state_first = 1
      !> Output names of the state variables from *DEPVAR lines ('' where none given)
      character(len=name_length), allocatable :: sdv_names(:)
      integer :: nfieldv = 0                      !< 1 with *USER DEFINED FIELD (field 1), else 0

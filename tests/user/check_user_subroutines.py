@@ -7,8 +7,8 @@ the result against a closed form. Usage:
     check_user_subroutines.py CASE --bulkflow BIN --matpoint BIN --work DIR [--abaqus-file F]
 
 Cases
-  (the element and MPM probes with *TEMPERATURE, AMPLITUDE=: T = T0 + 400 t, tempOld and
-  tempNew checked at both ends of every increment)
+  (the element, MPM and driver probes with *TEMPERATURE, AMPLITUDE=: T = T0 + 400 t, tempOld
+  and tempNew checked at both ends of every increment)
   probe_cpe4r_rotation  one CPE4R element: stretch, then a rigid rotation of 50 degrees
   probe_c3d8r_rotation  one C3D8R element: stretch, then a rotation of 40 degrees about (1,2,3)
   probe_cpe4r_block     12 x 12 CPE4R (144 elements: one solver block, two VUMAT calls)
@@ -16,7 +16,7 @@ Cases
   probe_cax4r_block     4 x 4 CAX4R from the axis: u_r = a r, u_z = c z (hoop stretch 1 + a in F33, U33)
   probe_mpm             an MPM column settling under gravity (400 particles; temperature and
                         two field variables from *INITIAL CONDITIONS on the material's particles)
-  probe_matpoint        bulkflow-matpoint oedometer test
+  probe_matpoint        bulkflow-matpoint oedometer test in two stages (temperature ramp)
   single_file_elements  our single Abaqus file as --user == the built-in models, bit for bit
   single_file_mpm       the same for an MPM hopper
   bad_compile           a file that does not compile: compiler messages, exit status 2
@@ -299,20 +299,31 @@ S, SDV
 
 
 def probe_matpoint(a):
+    """The driver's oedometer with *TEMPERATURE, AMPLITUDE= as the element and MPM probes: the
+    probe checks tempOld/tempNew = T0 + TRATE t at both ends of every increment, and records
+    tempNew in SDV6, checked here row by row."""
     work = a.work
     work.mkdir(parents=True, exist_ok=True)
     inp = work / 'probe_oedometer.inp'
+    total = 0.5
     inp.write_text(f"""*HEADING
-probe VUMAT in the material-point driver: oedometer
+probe VUMAT in the material-point driver: oedometer, temperature ramp
 *MATERIAL, NAME=PROBE-POINT
 *DENSITY
 {RHO}
 *USER MATERIAL, CONSTANTS=12
-{props_line([0, 0, 0], False, 0).replace(repr(T0), '0.0', 1)}
+{props_line([0, 0, 0], False, 0, TRATE)}
 *DEPVAR
 10
+*INITIAL CONDITIONS, TYPE=TEMPERATURE
+{T0!r}
+*AMPLITUDE, NAME=TRAMP
+0., {T0!r}, {total!r}, {T0 + TRATE * total!r}
+*TEMPERATURE, AMPLITUDE=TRAMP
+PROBE-POINT, 1.0
 *TEST, TYPE=OEDOMETER
-*STAGE, STRAIN=-0.05, INC=50
+*STAGE, STRAIN=-0.03, INC=30, TIME={total / 2!r}
+*STAGE, STRAIN=-0.02, INC=20, TIME={total / 2!r}
 """)
     run([a.matpoint, str(inp), '-o', str(work / 'probe.csv'), '--user', str(HERE / 'probe_vumat.f')], work)
     data = np.genfromtxt(work / 'probe.csv', delimiter=',', names=True)
@@ -321,6 +332,11 @@ probe VUMAT in the material-point driver: oedometer
     want = neo_hooke(f)
     check_close('s22, s11 at the end (oedometer)', [data['s22'][-1], data['s11'][-1]],
                 [want[1, 1], want[0, 0]], 1e-6 * abs(want[1, 1]))
+    rows = data[1:]
+    check_close('SDV6 = tempNew = T0 + rate t, every increment (*TEMPERATURE, AMPLITUDE=)', rows['SDV6'],
+                T0 + TRATE * rows['time'], 1e-9 * T0)
+    check_close('SDV10 = increments seen by point 1', rows['SDV10'][-1], len(rows), 0)
+    print(f'  {len(rows)} increments, T from {T0} to {rows["SDV6"][-1]:.6f}')
 
 
 def same_files(a_dir: Path, b_dir: Path, base: str, group: str):

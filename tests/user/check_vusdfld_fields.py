@@ -8,6 +8,9 @@ from coordMp; both kept in SDV1, SDV2; its VUMAT copies fieldNew(:, 2) to SDV3),
                               FIELDS=2: SDV1 = p0, SDV2 = SDV3 = the element centre's height
   fields_mpm                  a 2D column settling under gravity (FIELDS=2): the host's field
                               arrays have two columns (they had one: the VUSDFLD wrote past them)
+  fields_block_cpe4r          12 x 12 CPE4R (144 elements, one solver block): the VUSDFLD, which
+                              stops the run on nblock > 136 and records nblock in SDV4, is called
+                              with 136 and 8 points
   bad_vgetvrm_peeq            vgetvrm('PEEQ') on a user VUMAT: exit 2 naming the key
 """
 from __future__ import annotations
@@ -30,13 +33,14 @@ P0 = 3.0e4
 
 def material(name: str, ask_peeq: bool) -> str:
     return (f'*MATERIAL, NAME={name}\n*DENSITY\n{uc.RHO!r}\n*USER MATERIAL, CONSTANTS=3\n'
-            f'{uc.E!r}, {uc.NU!r}, {1.0 if ask_peeq else 0.0}\n*DEPVAR\n3\n'
+            f'{uc.E!r}, {uc.NU!r}, {1.0 if ask_peeq else 0.0}\n*DEPVAR\n4\n'
             '*USER DEFINED FIELD, FIELDS=2\n')
 
 
-def held_elements(a, ndim: int, ask_peeq: bool = False):
+def held_elements(a, ndim: int, ask_peeq: bool = False, n: tuple | None = None):
     scene = a.work / 'held.inp'
-    _, centroids = uc.element_scene(scene, ndim, (1,) * ndim, [0.0, 0.0, 0.0], [0, 0, 1], 0.0, 2e-3)
+    n = n or (1,) * ndim
+    _, centroids = uc.element_scene(scene, ndim, n, [0.0, 0.0, 0.0], [0, 0, 1], 0.0, 2e-3)
     text = scene.read_text()
     start, end = text.index('*MATERIAL'), text.index('*INITIAL CONDITIONS, TYPE=TEMPERATURE')
     stress = [-P0] * 3 + [0.0] * (1 if ndim == 2 else 3)
@@ -47,16 +51,25 @@ def held_elements(a, ndim: int, ask_peeq: bool = False):
     if ask_peeq:
         proc = uc.run(cmd, a.work, expect=2)
         message = proc.stdout + proc.stderr
-        if "vgetvrm('PEEQ')" not in message or 'not available' not in message:
+        if ("vgetvrm('PEEQ')" not in message or 'not available' not in message
+                or 'material PROBE-NEO' not in message or "vgetvrm(''SDV'')" in message
+                or "vgetvrm('SDV')" not in message):
             raise uc.Failed(f'the error does not name the key: {message[-600:]}')
-        print("  vgetvrm('PEEQ') on a user VUMAT: exit 2, " + message.strip().splitlines()[-2][:120])
+        print('  ' + [ln for ln in message.splitlines() if 'vgetvrm' in ln][0][:240])
         return
     uc.run(cmd, a.work)
     fr = uc.last_frame(a.work / 'held.h5', 'frames')
-    sdv = fr['SDV'][0]
-    uc.check_close('SDV1 = field 1 = pressure (vgetvrm S)', sdv[0], P0, 1e-9 * P0)
-    uc.check_close('SDV2 = field 2 = height (coordMp)', sdv[1], centroids[0][1], 1e-12)
-    uc.check_close('SDV3 = fieldNew(:, 2) seen by the VUMAT', sdv[2], centroids[0][1], 1e-12)
+    sdv = np.asarray(fr['SDV'], float)
+    heights = np.array([c[1] for c in centroids])
+    uc.check_close('SDV1 = field 1 = pressure (vgetvrm S)', sdv[:, 0], P0, 1e-9 * P0)
+    uc.check_close('SDV2 = field 2 = height (coordMp)', sdv[:, 1], heights, 1e-12)
+    uc.check_close('SDV3 = fieldNew(:, 2) seen by the VUMAT', sdv[:, 2], heights, 1e-12)
+    sizes = sorted(set(sdv[:, 3].astype(int)))
+    print(f'  {len(sdv)} elements, VUSDFLD nblock seen: {sizes}')
+    if max(sizes) > 136:
+        raise uc.Failed(f'the VUSDFLD got nblock {max(sizes)} > 136')
+    if len(sdv) == 144 and sizes != [8, 136]:
+        raise uc.Failed(f'144 elements in one block: expected VUSDFLD calls of 136 and 8 points, got {sizes}')
 
 
 def fields_mpm(a):
@@ -110,6 +123,7 @@ def main() -> int:
         'fields_c3d8r': lambda: held_elements(a, 3),
         'fields_cpe4r': lambda: held_elements(a, 2),
         'fields_mpm': lambda: fields_mpm(a),
+        'fields_block_cpe4r': lambda: held_elements(a, 2, n=(12, 12)),
         'bad_vgetvrm_peeq': lambda: held_elements(a, 3, ask_peeq=True),
     }
     if a.case not in cases:

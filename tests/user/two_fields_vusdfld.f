@@ -1,6 +1,8 @@
 C     Test user file in users' style: an elastic VUMAT and a VUSDFLD that writes two field
 C     variables, field 1 = pressure of the start-of-increment stress (vgetvrm 'S'), field 2 =
-C     the point's current height (coordMp), and keeps them in SDV1 and SDV2.
+C     the point's current height (coordMp), and keeps them in SDV1 and SDV2;
+C     SDV4 (when declared) = the nblock of its call, which must not exceed
+C     n_vec_Length (136; the run stops through xplb_abqerr -3 otherwise).
       subroutine vumat(
      1 nblock, ndir, nshr, nstatev, nfieldv, nprops, lanneal,
      2 stepTime, totalTime, dt, cmname, coordMp, charLength,
@@ -56,6 +58,11 @@ C
       character*80 cmname
       character*3 cData(maxblk*6)
       dimension rData(maxblk*6), jData(maxblk*6)
+      if (nblock .gt. n_vec_Length) then
+        call xplb_abqerr(-2, 'VUSDFLD: nblock above n_vec_Length',
+     1    0, zero, ' ')
+        call xplb_exit
+      end if
       jStatus = 1
       call vgetvrm('S', rData, jData, cData, jStatus)
       if (jStatus .ne. 0) then
@@ -68,6 +75,7 @@ C
         field(k,2) = coordMp(k,2)
         stateNew(k,1) = field(k,1)
         stateNew(k,2) = field(k,2)
+        if (nstatev .ge. 4) stateNew(k,4) = nblock
       end do
       if (props(3) .gt. 0.d0) then
 C       asks for PEEQ, which a user VUMAT does not have: the host must stop
