@@ -77,9 +77,18 @@ contains
 
   function host_block_material() result(name)
     character(len=:), allocatable :: name
-    name = '(unknown)'
-    if (allocated(block_material)) name = block_material
+    name = set_or(block_material, '(unknown)')
   end function host_block_material
+
+  !> `text` once it has been set, else `default`.
+  pure function set_or(text, default) result(answer)
+    character(len=:), allocatable, intent(in) :: text
+    character(len=*), intent(in) :: default
+    character(len=:), allocatable :: answer
+
+    answer = default
+    if (allocated(text)) answer = text
+  end function set_or
 
   !> Why the current block has no `key` (for vgetvrm's error), '' when there is nothing to add.
   !> PEEQ: Abaqus keeps an equivalent plastic strain only for its own plasticity models (a user
@@ -205,14 +214,12 @@ contains
 
   function host_job_name() result(name)
     character(len=:), allocatable :: name
-    name = 'bulkflow'
-    if (allocated(job_name)) name = job_name
+    name = set_or(job_name, 'bulkflow')
   end function host_job_name
 
   function host_output_dir() result(folder)
     character(len=:), allocatable :: folder
-    folder = '.'
-    if (allocated(output_dir)) folder = output_dir
+    folder = set_or(output_dir, '.')
   end function host_output_dir
 
   integer function host_rank()
