@@ -235,6 +235,8 @@ def host_elements(case, user_file, work: Path, ndim: int, check):
     ctx = {'F': f_end}
     if rate:
         times = np.genfromtxt(work / 'compress_history.csv', delimiter=',', names=True)['time']
+        if not math.isclose(times[-1], total, rel_tol=1e-12):
+            raise uc.Failed(f'the history ends at t = {times[-1]!r}, not at the step end {total!r}')
         ctx['temp_old'], ctx['temp_new'] = uc.T0 + rate * times[-2], uc.T0 + rate * times[-1]
     return check(s6, fr['SDV'][0], ctx)
 
