@@ -9,9 +9,13 @@ CASES below and in the docs), into one folder, under the names CASES gives, e.g.
 
     git clone https://github.com/irfancn/Abaqus-VUMAT-Johnson-Cook /tmp/jc
     cp /tmp/jc/vumat_JC.for /tmp/public_vumats/irfancn_vumat_JC.for
-    python3 scripts/check_public_vumats.py --dir /tmp/public_vumats [--build build]
+    python3 scripts/check_public_vumats.py --dir /tmp/public_vumats [--build build] [--only NAME ...]
 
-Hosts: C3D8R and CPE4R (a homogeneous uniaxial-strain compression, every node prescribed),
+(pantale/abaqusVumat's Sources/VUMAT-NR.f INCLUDEs 'JohnsonCook.f': put that file, unchanged and
+under its own name, next to it, as Abaqus users do.)
+
+Hosts: C3D8R and CPE4R (a homogeneous stretch, uniaxial-strain compression unless the case gives
+another, every node prescribed; with temp_rate a *TEMPERATURE ramp T0 + rate t),
 MPM (a 3D column settling under gravity between frictionless walls: sigma_yy = -rho g (H - y)
 whatever the material) and bulkflow-matpoint (an oedometer test). A host a file cannot serve
 (a VUMAT written for 3D only) is skipped and said so.
@@ -42,7 +46,7 @@ def jc_check(props):
     the Mises stress equals A + B eps_p^n with eps_p = SDV2."""
     a_, b_, n_ = props[2], props[3], props[5]
 
-    def check(stress6, sdv):
+    def check(stress6, sdv, ctx=None):
         s = np.asarray(stress6, float)
         p = s[:3].mean()
         d = s.copy()
@@ -60,7 +64,7 @@ def ice_check(props):
     """Pressure-dependent (Tsai-Wu) ice: on yielding, J2 = a0 + a1 p + a2 p^2, p = -tr(sigma)/3."""
     a0, a1, a2 = props[2], props[3], props[4]
 
-    def check(stress6, sdv):
+    def check(stress6, sdv, ctx=None):
         s = np.asarray(stress6, float)
         p = -s[:3].mean()
         d = s.copy()
@@ -69,6 +73,53 @@ def ice_check(props):
         if sdv[6] <= 0:
             raise uc.Failed(f'no plastic strain (J2 = {j2:.6e}); the path must yield')
         return j2, a0 + a1 * p + a2 * p * p
+    return check
+
+
+def mises(stress6):
+    s = np.asarray(stress6, float)
+    d = s.copy()
+    d[:3] -= s[:3].mean()
+    return math.sqrt(1.5 * (d[0] ** 2 + d[1] ** 2 + d[2] ** 2 + 2 * (d[3] ** 2 + d[4] ** 2 + d[5] ** 2)))
+
+
+def jc_thermal_check(props):
+    """Johnson-Cook with thermal softening, the temperature from the host (its constant 14 = 1,
+    "coupled": T = tempOld), rate term and Taylor-Quinney heating off: on yielding the Mises
+    stress is (A + B eps_p^n)(1 - T*^m), T* = (T - T0)/(Tm - T0), eps_p = SDV1, T the host's
+    temperature at the start of the increment (the file records the T it used in SDV5)."""
+    a_, b_, n_, m_, t0, tm = props[2], props[3], props[4], props[6], props[8], props[9]
+
+    def check(stress6, sdv, ctx):
+        ep, t_used, t_old = sdv[0], sdv[4], ctx['temp_old']
+        if ep <= 0:
+            raise uc.Failed(f'no plastic strain (q = {mises(stress6):.6e}); the path must yield')
+        if not abs(t_used - t_old) <= 1e-9 * abs(t_old):
+            raise uc.Failed(f'the file used T = {t_used!r} (SDV5); tempOld should be {t_old!r} '
+                            f'(tempNew = {ctx["temp_new"]!r})')
+        want = (a_ + b_ * ep ** n_) * (1 - ((t_old - t0) / (tm - t0)) ** m_)
+        return [('Mises stress', mises(stress6), want), ('T used (SDV5) vs tempOld', t_used, t_old)]
+    return check
+
+
+def evans_skalak_check(props):
+    """Evans-Skalak membrane law on the stretches lambda1 = F11, lambda2 = F33 (the file's
+    in-plane directions; F22 its thickness direction): tensions T1 = K (l1 l2 - 1) +
+    mu (l1^2 - l2^2)/(2 l1^2 l2^2), T2 likewise with 1 and 2 swapped, Cauchy stresses
+    s11 = l1 T1 / J, s33 = l2 T2 / J (J = l1 F22 l2), s22 = 0. The file writes the area term
+    as K' (1 - l1 l2): its constant 2 is K' = -K (Evans and Skalak 1980, Mechanics and
+    Thermodynamics of Biomembranes)."""
+    mu, k_area = props[0], -props[1]
+
+    def check(stress6, sdv, ctx):
+        f = ctx['F']
+        l1, l2, h = f[0, 0], f[2, 2], f[1, 1]
+        shear = mu * (l1 ** 2 - l2 ** 2) / (2 * l1 ** 2 * l2 ** 2)
+        t1, t2 = k_area * (l1 * l2 - 1) + shear, k_area * (l1 * l2 - 1) - shear
+        jac = l1 * l2 * h
+        if abs(stress6[1]) > 0:
+            raise uc.Failed(f'sigma22 = {stress6[1]!r}; the membrane law writes 0')
+        return [('sigma11', stress6[0], l1 * t1 / jac), ('sigma33', stress6[2], l2 * t2 / jac)]
     return check
 
 
@@ -99,6 +150,27 @@ CASES = {
         # after its 200 iterations without reaching the surface in large increments
         strain=-0.004,
         what='pressure-dependent (Tsai-Wu) plasticity of ice, single-precision locals'),
+    'johnson_cook_thermal': dict(
+        repo='pantale/abaqusVumat', path='Sources/VUMAT-NR.f (INCLUDEs Sources/JohnsonCook.f)',
+        file='pantale_VUMAT-NR.f', needs=['JohnsonCook.f'],
+        # E, nu, A, B, n, C (rate: 0), m, eps0_dot, T0, Tm, Taylor-Quinney (heating: 0), rho0, Cp,
+        # coupled = 1 (temperature from the host's tempOld)
+        props=[2.0e10, 0.3, 2.0e8, 1.0e8, 0.3, 0.0, 1.2, 1.0, 293.0, 1500.0, 0.0, 7800.0, 460.0, 1.0],
+        depvar=7, density=7800.0, hosts=['cpe4r', 'c3d8r', 'matpoint', 'mpm3d'], check=jc_thermal_check,
+        tol=1e-6, strain=-0.04,
+        # elements: T = 293 + 3e5 t (293 -> 893 K over the 2e-3 s step); driver: constant 700 K
+        temp_rate=3.0e5, matpoint_temperature=700.0,
+        what='J2 plasticity, Johnson-Cook hardening with thermal softening from tempOld (*TEMPERATURE)'),
+    'evans_skalak': dict(
+        repo='nima-mostafa-zadeh/Shell-FEM', path='abaqus/models/stretching/evans_skalak/evans_skalak_vumat.f',
+        file='shellfem_evans_skalak_vumat.f',
+        # mu, K' (the file's area constant, K' = -K: area modulus K = 2e6)
+        props=[1.0e6, -2.0e6], depvar=4, density=1000.0, hosts=['cpe4r', 'c3d8r'], check=evans_skalak_check,
+        tol=1e-9, stretch={2: [0.1, -0.02, 0.0], 3: [0.1, -0.02, -0.05]},
+        why={'mpm3d': 'a membrane law: sigma22 is 0 whatever F22, so a column loaded in direction 2 cannot stand',
+             'matpoint': "the file writes no shear stress: the driver's two-point packaging probe finds "
+                         '2G = 0 and stops naming the material'},
+        what='hyperelastic membrane (Evans-Skalak) from defgradNew'),
     'ice_vusdfld': dict(
         repo='NTNU-IMT/Ice-Elastoplastic-Material-Model', path='src/VUSDFLD.for', file='ntnu_imt_VUSDFLD.for',
         # a VUSDFLD only: on our *MOHR COULOMB (MPa: E, nu; phi, psi; c), which has the PEEQ it reads
@@ -144,32 +216,43 @@ def material_block(name, case):
 def host_elements(case, user_file, work: Path, ndim: int, check):
     work.mkdir(parents=True, exist_ok=True)
     scene = work / 'compress.inp'
-    stretch = [0.0, case['strain'], 0.0]
-    uc.element_scene(scene, ndim, (1,) * ndim, stretch, [0, 0, 1], 0.0, 2e-3)
+    stretch = case['stretch'][ndim] if 'stretch' in case else [0.0, case['strain'], 0.0]
+    rate, total = case.get('temp_rate', 0.0), 2e-3
+    f_end, _ = uc.element_scene(scene, ndim, (1,) * ndim, stretch, [0, 0, 1], 0.0, total, temp_rate=rate)
     text = scene.read_text()
     start = text.index('*MATERIAL')
     end = text.index('*INITIAL CONDITIONS')
-    text = text[:start] + material_block('PUBLIC', case) + text[end:].split('*AMPLITUDE', 1)[0] \
-        + '*AMPLITUDE' + text[end:].split('*AMPLITUDE', 1)[1]
+    text = text[:start] + material_block('PUBLIC', case) + text[end:]
     text = text.replace('MATERIAL=PROBE-NEO', 'MATERIAL=PUBLIC')
+    if rate:
+        # every increment in the history: the time at the start of the last one gives its tempOld
+        text = text.replace('*OUTPUT, HISTORY, NUMBER INTERVAL=10', '*OUTPUT, HISTORY, FREQUENCY=1')
     scene.write_text(text)
     run([str(BULKFLOW), str(scene), '--quiet', '--user', str(user_file)], work)
     fr = uc.last_frame(work / 'compress.h5', 'frames')
     s = fr['S'][0]
     s6 = list(s) if len(s) == 6 else [s[0], s[1], s[2], s[3], 0.0, 0.0]
-    return check(s6, fr['SDV'][0])
+    ctx = {'F': f_end}
+    if rate:
+        times = np.genfromtxt(work / 'compress_history.csv', delimiter=',', names=True)['time']
+        if not math.isclose(times[-1], total, rel_tol=1e-12):
+            raise uc.Failed(f'the history ends at t = {times[-1]!r}, not at the step end {total!r}')
+        ctx['temp_old'], ctx['temp_new'] = uc.T0 + rate * times[-2], uc.T0 + rate * times[-1]
+    return check(s6, fr['SDV'][0], ctx)
 
 
 def host_matpoint(case, user_file, work: Path, check):
     work.mkdir(parents=True, exist_ok=True)
     inp = work / 'oedometer.inp'
-    inp.write_text('*HEADING\npublic VUMAT, oedometer\n' + material_block('PUBLIC', case)
+    temp = case.get('matpoint_temperature')
+    extra = f'*INITIAL CONDITIONS, TYPE=TEMPERATURE\n{temp!r}\n' if temp is not None else ''
+    inp.write_text('*HEADING\npublic VUMAT, oedometer\n' + material_block('PUBLIC', case) + extra
                    + f'*TEST, TYPE=OEDOMETER\n*STAGE, STRAIN={case["strain"]}, INC=100\n')
     run([str(MATPOINT), str(inp), '-o', 'oedometer.csv', '--user', str(user_file)], work)
     data = np.genfromtxt(work / 'oedometer.csv', delimiter=',', names=True)
     s6 = [data[c][-1] for c in ('s11', 's22', 's33', 's12', 's23', 's31')]
     sdv = [data[f'SDV{i}'][-1] for i in range(1, case['depvar'] + 1)]
-    return check(s6, sdv)
+    return check(s6, sdv, {'temp_old': temp, 'temp_new': temp})
 
 
 def host_mpm3d(case, user_file, work: Path):
@@ -191,53 +274,71 @@ def host_mpm3d(case, user_file, work: Path):
     return err, 0.05 * rho * g * height
 
 
+def verdict(ok: bool) -> str:
+    return 'PASS' if ok else 'FAIL'
+
+
+def run_host(case, host, user_file, work, check):
+    """One host of one case: prints its lines, returns the number of failures."""
+    if check is None:
+        pairs = host_vusdfld(case, user_file, work, 2 if host == 'cpe4r' else 3)
+        ok = all(abs(g - w) <= case['tol'] * max(1.0, abs(w)) for g, w in pairs)
+        print(f'  {host:9s} fields ' + ', '.join(f'{g:.9e} (closed form {w:.9e})' for g, w in pairs)
+              + f' {verdict(ok)}')
+        return 0 if ok else 1
+    if host == 'mpm3d':
+        err, tol = host_mpm3d(case, user_file, work)
+        print(f'  {host:9s} sigma_yy vs -rho g (H - y): max error {err:.3e} (limit {tol:.1e})'
+              f' {verdict(err <= tol)}')
+        return 0 if err <= tol else 1
+    if host == 'matpoint':
+        result = host_matpoint(case, user_file, work, check)
+    else:
+        result = host_elements(case, user_file, work, 2 if host == 'cpe4r' else 3, check)
+    if isinstance(result, tuple):
+        result = [('yield measure', *result)]
+    failures = 0
+    for label, got, want in result:
+        rel = abs(got - want) / abs(want)
+        ok = rel <= case['tol']
+        failures += 0 if ok else 1
+        print(f'  {host:9s} {label} {got:.9e}, closed form {want:.9e}, relative error {rel:.2e} {verdict(ok)}')
+    return failures
+
+
 def main() -> int:
     global BULKFLOW, MATPOINT
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument('--dir', type=Path, required=True, help='folder with the downloaded files')
     p.add_argument('--build', type=Path, default=REPO / 'build')
     p.add_argument('--work', type=Path, default=Path('/tmp/bulkflow_public_vumats'))
+    p.add_argument('--only', nargs='+', choices=sorted(CASES), help='run these cases only')
     a = p.parse_args()
     BULKFLOW = a.build / 'bin' / 'bulkflow'
     MATPOINT = a.build / 'bin' / 'bulkflow-matpoint'
     os.environ.setdefault('BULKFLOW_CACHE_DIR', str(a.work / 'cache'))
     failures = 0
     for name, case in CASES.items():
+        if a.only and name not in a.only:
+            continue
         user_file = a.dir / case['file']
         print(f'{name}: {case["repo"]} {case["path"]} ({case["what"]})')
-        if not user_file.exists():
-            print(f'  missing {user_file}: download it first')
+        missing = [f for f in [case['file'], *case.get('needs', [])] if not (a.dir / f).exists()]
+        if missing:
+            print(f'  missing {", ".join(str(a.dir / f) for f in missing)}: download first  FAIL')
             failures += 1
             continue
         check = case['check'](case['props']) if 'props' in case else None
         for host in ('cpe4r', 'c3d8r', 'mpm3d', 'matpoint'):
             if host not in case['hosts']:
                 why = {'mpm3d': 'particles write no FV', 'matpoint': 'the driver keeps its own VUSDFLD door'}
-                print(f'  {host:9s} skipped ({why[host] if check is None else "the file does not serve it"})')
+                reason = why[host] if check is None else case.get('why', {}).get(host, 'the file does not serve it')
+                print(f'  {host:9s} skipped ({reason})')
                 continue
             try:
-                work = a.work / name / host
-                if check is None:
-                    pairs = host_vusdfld(case, user_file, work, 2 if host == 'cpe4r' else 3)
-                    ok = all(abs(g - w) <= case['tol'] * max(1.0, abs(w)) for g, w in pairs)
-                    print(f'  {host:9s} fields ' + ', '.join(f'{g:.9e} (closed form {w:.9e})' for g, w in pairs)
-                          + f' {"OK" if ok else "FAILED"}')
-                elif host == 'mpm3d':
-                    err, tol = host_mpm3d(case, user_file, work)
-                    ok = err <= tol
-                    print(f'  {host:9s} sigma_yy vs -rho g (H - y): max error {err:.3e} (limit {tol:.1e})'
-                          f' {"OK" if ok else "FAILED"}')
-                else:
-                    if host == 'matpoint':
-                        got, want = host_matpoint(case, user_file, work, check)
-                    else:
-                        got, want = host_elements(case, user_file, work, 2 if host == 'cpe4r' else 3, check)
-                    ok = abs(got - want) <= case['tol'] * abs(want)
-                    print(f'  {host:9s} yield measure {got:.9e}, closed form {want:.9e}, relative error '
-                          f'{abs(got - want) / abs(want):.2e} {"OK" if ok else "FAILED"}')
-                failures += 0 if ok else 1
+                failures += run_host(case, host, user_file, a.work / name / host, check)
             except uc.Failed as exc:
-                print(f'  {host:9s} FAILED: {exc}')
+                print(f'  {host:9s} FAIL: {exc}')
                 failures += 1
     print('all passed' if failures == 0 else f'{failures} failure(s)')
     return 0 if failures == 0 else 1
