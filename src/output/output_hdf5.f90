@@ -45,8 +45,7 @@ module output_hdf5
   use output_hdf5_basics, only: hdf5_error_context, check, create_dataset, write_attr_int, &
        write_attr_real, write_attr_string
   use output_hdf5_rows, only: write_rows_real, write_rows_int
-  ! frame_sequence is re-exported: src/mpm/mpm_output.f90 reopens its particle frames with it.
-  use output_hdf5_frames, only: reopen_frames, frame_sequence, frame_path, new_xdmf_frame, &
+  use output_hdf5_frames, only: reopen_frames, frame_path, new_xdmf_frame, &
        move_frame, coordinates_name
   implicit none
   private
@@ -54,7 +53,7 @@ module output_hdf5
   public :: field_writer_t
   public :: field_writer_open, field_writer_frame, field_writer_end_frame
   public :: field_writer_coordinates, field_writer_node_field, field_writer_element_field
-  public :: field_writer_close, field_writer_frame_count, frame_sequence
+  public :: field_writer_close, field_writer_frame_count
 
   integer, parameter :: format_version = 1
 

@@ -182,6 +182,7 @@ contains
     type(xdmf_frame_t), intent(inout) :: to
 
     to%time = from%time
+    to%n_points = from%n_points
     to%n_attributes = from%n_attributes
     call move_alloc(from%name, to%name)
     call move_alloc(from%geometry, to%geometry)
