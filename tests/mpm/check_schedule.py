@@ -123,6 +123,16 @@ def main():
             if not same:
                 print('      expected: ' + ' '.join(f'{s}:{t:.4f}' for s, t in want))
                 failed = True
+    # listed times are reached exactly: the output's step_time is the listed number bit for bit
+    for kind in ('field', 'history'):
+        listed = {(s, t) for s, (_, _, field, history) in enumerate(STEPS, start=1)
+                  for k, v in (field if kind == 'field' else history) if k == 'P' for t in v}
+        for solver in ('element', 'mpm'):
+            hit = listed & set(got[(kind, solver)])
+            same = hit == listed
+            print(f"{'ok  ' if same else 'FAIL'} {solver:7s} {kind:7s}: {len(hit)} of {len(listed)} TIME POINTS "
+                  f"outputs at exactly the listed step time")
+            failed |= not same
     sys.exit(1 if failed else 0)
 
 
