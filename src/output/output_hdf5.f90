@@ -46,7 +46,7 @@ module output_hdf5
        write_attr_real, write_attr_string
   use output_hdf5_rows, only: write_rows_real, write_rows_int
   use output_hdf5_frames, only: reopen_frames, frame_path, new_xdmf_frame, &
-       move_frame, coordinates_name
+       grow_frames, coordinates_name
   implicit none
   private
 
@@ -248,9 +248,8 @@ contains
     real(dp), intent(in) :: step_time
     real(dp), intent(in) :: total_time
     integer, intent(in) :: increment      !< increment number
-    type(xdmf_frame_t), allocatable :: grown(:)
     integer(hid_t) :: gcpl
-    integer :: hdferr, i
+    integer :: hdferr
     character(len=6) :: tag
 
     call require_open(w, 'field_writer_frame')
@@ -271,13 +270,7 @@ contains
     call write_attr_real(w%frame_group, 'step_time', step_time)
     call write_attr_real(w%frame_group, 'total_time', total_time)
 
-    if (w%n_frames == size(w%frames)) then
-       allocate (grown(2 * size(w%frames)))
-       do i = 1, w%n_frames
-          call move_frame(w%frames(i), grown(i))
-       end do
-       call move_alloc(grown, w%frames)
-    end if
+    call grow_frames(w%frames, w%n_frames)
     w%n_frames = w%n_frames + 1
     call new_xdmf_frame(w%frames(w%n_frames), tag, total_time)
     w%frame_open = .true.

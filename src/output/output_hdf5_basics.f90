@@ -54,21 +54,12 @@ contains
     integer, intent(in) :: ncomp
     integer, intent(in) :: nrows
     integer(hid_t), intent(out) :: dset
-    integer(hid_t) :: space, dcpl
-    integer :: hdferr
 
     if (ncomp == 1) then
-       call h5screate_simple_f(1, [int(nrows, hsize_t)], space, hdferr)
+       call create_shaped_dataset(loc, name, file_type, [int(nrows, hsize_t)], dset)
     else
-       call h5screate_simple_f(2, [int(ncomp, hsize_t), int(nrows, hsize_t)], space, hdferr)
+       call create_shaped_dataset(loc, name, file_type, [int(ncomp, hsize_t), int(nrows, hsize_t)], dset)
     end if
-    call check(hdferr, 'creating the dataspace of ' // name)
-    call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, hdferr)
-    call h5pset_fill_time_f(dcpl, H5D_FILL_TIME_NEVER_F, hdferr)
-    call h5dcreate_f(loc, name, file_type, space, dset, hdferr, dcpl_id=dcpl)
-    call check(hdferr, 'creating dataset ' // name)
-    call h5pclose_f(dcpl, hdferr)
-    call h5sclose_f(space, hdferr)
   end subroutine create_dataset
 
   !> A dataset of any Fortran shape `dims` (h5py shows it reversed), contiguous, never filled:

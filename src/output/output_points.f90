@@ -32,7 +32,7 @@ module output_points
   use output_hdf5_basics, only: hdf5_error_context, check, create_shaped_dataset, write_attr_string, &
        write_attr_ints, write_attr_reals, read_attr_ints, read_attr_reals
   use output_hdf5_rows, only: write_rows_real, write_rows_int, write_whole_real
-  use output_hdf5_frames, only: frame_sequence, move_frame
+  use output_hdf5_frames, only: frame_sequence, grow_frames
   implicit none
   private
 
@@ -190,16 +190,24 @@ contains
   end subroutine point_writer_frame
 
   !> A point field values(ncomp, n_local) of the open frame: dataset (count, ncomp), 2-D also
-  !> for one component.
-  subroutine point_writer_field(w, name, values)
+  !> for one component unless one_dimensional (then (count,)).
+  subroutine point_writer_field(w, name, values, one_dimensional)
     type(point_writer_t), intent(inout) :: w
     character(len=*), intent(in) :: name
     real(dp), intent(in) :: values(:, :)
+    logical, intent(in), optional :: one_dimensional
     integer(hid_t) :: dset
     integer :: hdferr
+    logical :: flat
 
-    call create_shaped_dataset(w%points, name, H5T_IEEE_F64LE, &
-         [int(size(values, 1), hsize_t), int(total_rows(w), hsize_t)], dset)
+    flat = .false.
+    if (present(one_dimensional)) flat = one_dimensional
+    if (flat) then
+       call create_shaped_dataset(w%points, name, H5T_IEEE_F64LE, [int(total_rows(w), hsize_t)], dset)
+    else
+       call create_shaped_dataset(w%points, name, H5T_IEEE_F64LE, &
+            [int(size(values, 1), hsize_t), int(total_rows(w), hsize_t)], dset)
+    end if
     call write_rows_real(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, size(values, 1), &
          local_rows(w), values)
     call h5dclose_f(dset, hdferr)
@@ -210,13 +218,8 @@ contains
     type(point_writer_t), intent(inout) :: w
     character(len=*), intent(in) :: name
     real(dp), intent(in) :: values(:)
-    integer(hid_t) :: dset
-    integer :: hdferr
 
-    call create_shaped_dataset(w%points, name, H5T_IEEE_F64LE, [int(total_rows(w), hsize_t)], dset)
-    call write_rows_real(w%comm, w%rank, w%nranks, w%xfer, w%h5_path, dset, 1, local_rows(w), &
-         reshape(values, [1, size(values)]))
-    call h5dclose_f(dset, hdferr)
+    call point_writer_field(w, name, reshape(values, [1, size(values)]), one_dimensional=.true.)
   end subroutine point_writer_scalar
 
   !> An integer point field values(n_local): dataset (count,) int32.
@@ -312,22 +315,11 @@ contains
     character(len=*), intent(in) :: tag
     integer, intent(in) :: count
     real(dp), intent(in) :: time
-    type(xdmf_frame_t), allocatable :: grown(:)
     integer :: i, f
 
     f = w%n_frames + 1
-    if (f > size(w%frames)) then
-       allocate (grown(2 * size(w%frames)))
-       do i = 1, w%n_frames
-          call move_frame(w%frames(i), grown(i))
-       end do
-       call move_alloc(grown, w%frames)
-       allocate (grown(2 * size(w%grid_frames)))
-       do i = 1, w%n_frames
-          call move_frame(w%grid_frames(i), grown(i))
-       end do
-       call move_alloc(grown, w%grid_frames)
-    end if
+    call grow_frames(w%frames, w%n_frames)
+    call grow_frames(w%grid_frames, w%n_frames)
     associate (p => w%frames(f), g => w%grid_frames(f))
       p%name = 'particles_' // tag
       p%time = time
