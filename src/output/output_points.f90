@@ -22,11 +22,11 @@
 !> Every routine is collective over the writer's communicator.
 module output_points
   use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Exscan, MPI_Bcast, &
-       MPI_IN_PLACE, MPI_INTEGER, MPI_LOGICAL, MPI_SUM, MPI_INFO_NULL
+       MPI_INTEGER, MPI_LOGICAL, MPI_SUM, MPI_INFO_NULL
   use hdf5
   use base_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use output_files, only: base_name, int_to_str, file_exists
+  use output_files, only: base_name, file_exists
   use output_collective, only: agree_on_error
   use output_xdmf, only: xdmf_mesh_t, xdmf_frame_t, xdmf_write, xdmf_add_attribute, xdmf_center_node
   use output_hdf5_basics, only: hdf5_error_context, check, create_shaped_dataset, write_attr_string, &
