@@ -4,6 +4,7 @@ exit status, the history CSV (bytes) and every dataset and attribute of the .h5 
 must be identical.
 
     python3 scripts/compare_binaries.py OLD_BIN NEW_BIN DECK... [--stop-after 300] [--workdir DIR]
+                                        [--ranks N [--mpiexec mpirun]]
 
 OLD_BIN is typically main's build (build it from a clean checkout of main), NEW_BIN the branch's.
 Prints one line per deck and exits 1 if any deck differs.
@@ -54,6 +55,8 @@ def main(argv=None) -> int:
     ap.add_argument('decks', nargs='+', type=Path)
     ap.add_argument('--stop-after', type=int, default=300, help='increments per run (default 300)')
     ap.add_argument('--workdir', type=Path, help='keep the outputs here (default: a scratch directory)')
+    ap.add_argument('--ranks', type=int, default=1, help='MPI ranks per run (default 1: no mpiexec)')
+    ap.add_argument('--mpiexec', default='mpirun', help='launcher for --ranks > 1 (default mpirun)')
     a = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix='bulkflow_compare_') as tmp:
         work = a.workdir or Path(tmp)
@@ -63,8 +66,10 @@ def main(argv=None) -> int:
             runs = []
             for tag, exe in (('old', a.old), ('new', a.new)):
                 base = work / f'{deck.stem}_{tag}'
-                p = subprocess.run([exe, str(deck.resolve()), '--output', str(base), '--stop-after',
-                                    str(a.stop_after), '--quiet'], capture_output=True, text=True, timeout=600)
+                launch = [a.mpiexec, '-np', str(a.ranks), '--oversubscribe'] if a.ranks > 1 else []
+                p = subprocess.run(launch + [exe, str(deck.resolve()), '--output', str(base), '--stop-after',
+                                             str(a.stop_after), '--quiet'], capture_output=True, text=True,
+                                   timeout=600)
                 runs.append((base, p.returncode))
             (b0, r0), (b1, r1) = runs
             h0, h1 = Path(f'{b0}_history.csv'), Path(f'{b1}_history.csv')

@@ -248,7 +248,7 @@ contains
           call node_history_output(blk, model, os, err)
        end if
     case ('ELEMENT OUTPUT')
-       call element_output(blk, os, err)
+       call element_output(blk, model%mpm%active, os, err)
     case default
        call energy_output(blk, os, err)
     end select
@@ -337,8 +337,10 @@ contains
     call push_history(os, h)
   end subroutine node_history_output
 
-  subroutine element_output(blk, os, err)
+  !> particles: a material-point scene, whose particles also write TEMP (their temperature).
+  subroutine element_output(blk, particles, os, err)
     type(keyword_block_t), intent(in) :: blk
+    logical, intent(in) :: particles
     type(output_state_t), intent(inout) :: os
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: name, directions
@@ -361,6 +363,14 @@ contains
           name = field_name(blk%lines(il), k)
           select case (name)
           case ('S', 'LE', 'PE', 'PEEQ', 'SDV', 'FV', 'STATUS')
+             call add_name(os%field(os%n_field)%element_variables, name)
+          case ('TEMP')
+             if (.not. particles) then
+                call raise_error(blk%lines(il)%file, blk%lines(il)%line, 'element output variable TEMP ' // &
+                     'is written for the particles of material-point scenes only; expected S, LE, PE, PEEQ, ' // &
+                     'SDV, FV or STATUS', err)
+                return
+             end if
              call add_name(os%field(os%n_field)%element_variables, name)
           case default
              call raise_error(blk%lines(il)%file, blk%lines(il)%line, 'element output variable ' // &

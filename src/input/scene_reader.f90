@@ -95,7 +95,6 @@ contains
        if (err%raised) return
        call count_user_fields(model)
        call build_steps(deck, layout, model, err)
-       if (.not. err%raised) call refuse_time_points(deck, err)
        return
     end if
     call build_mesh(deck, layout, model, sources, err)
@@ -121,23 +120,6 @@ contains
     call count_user_fields(model)
     call build_steps(deck, layout, model, err)
   end subroutine read_scene
-
-  !> The MPM run has no increment cutting onto listed times: TIME POINTS= is refused there.
-  subroutine refuse_time_points(deck, err)
-    type(keyword_deck_t), intent(in) :: deck
-    type(error_t), intent(inout) :: err
-    integer :: i
-
-    do i = 1, deck%n_blocks
-       if (deck%blocks(i)%name /= 'OUTPUT') cycle
-       if (deck%blocks(i)%has_param('TIME POINTS')) then
-          call deck%blocks(i)%fail('*OUTPUT, TIME POINTS= in a material-point scene is not supported (the ' // &
-               'MPM run does not cut its increments onto listed times); expected NUMBER INTERVAL=n, ' // &
-               'TIME INTERVAL=t or FREQUENCY=n', err)
-          return
-       end if
-    end do
-  end subroutine refuse_time_points
 
   !> A user's VUMAT or VUSDFLD receives every field variable the scene defines (nfieldv = the
   !> highest VARIABLE= of *INITIAL CONDITIONS, TYPE=FIELD, or FIELDS= of *USER DEFINED FIELD if

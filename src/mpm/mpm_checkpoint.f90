@@ -33,7 +33,7 @@ module mpm_checkpoint
   use checkpoint_scene, only: put_scene_digest, check_saved_scene
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate
   use mpm_grid, only: grid_t
-  use mpm_output, only: mpm_writer_t, mpm_writer_open
+  use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_field_request_t
   use output_checkpoint, only: checkpoint_t, checkpoint_header_t, checkpoint_begin_write, checkpoint_put, &
        checkpoint_end_write, restart_begin_read, checkpoint_get, checkpoint_end_read, checkpoint_file_name
   use output_collective, only: agree_on_error
@@ -265,29 +265,21 @@ contains
   end subroutine mpm_checkpoint_load
 
   !> Reopen the outputs of the interrupted run at the checkpoint: BASE.h5 keeps its first
-  !> `frames` frames (rank 0 writes it), BASE_history.csv its first `rows` rows. Collective.
-  subroutine mpm_restart_outputs(base, comm, g, ncomp, nsdv, columns, frames, rows, wr, hist, err)
+  !> `frames` frames, BASE_history.csv its first `rows` rows. Collective.
+  subroutine mpm_restart_outputs(base, comm, g, ncomp, fields, columns, frames, rows, wr, hist, err)
     character(len=*), intent(in) :: base
     type(MPI_Comm), intent(in) :: comm
     type(grid_t), intent(in) :: g
-    integer, intent(in) :: ncomp, nsdv
+    integer, intent(in) :: ncomp
+    type(mpm_field_request_t), intent(in) :: fields
     character(len=*), intent(in) :: columns(:)
     integer, intent(in) :: frames, rows
     type(mpm_writer_t), intent(inout) :: wr
     type(history_t), intent(inout) :: hist
     type(error_t), intent(inout) :: err
-    type(error_t) :: e
-    character(len=:), allocatable :: msg
-    integer :: rank
-    logical :: any_failed
 
-    call MPI_Comm_rank(comm, rank)
-    if (rank == 0) call mpm_writer_open(wr, base, g, ncomp, nsdv, restart_frames=frames, err=e)
-    if (e%raised) msg = e%message
-    call agree_on_error(comm, e%raised, msg, any_failed)
-    if (any_failed) then
-       err%raised = .true.
-       err%message = msg
+    call mpm_writer_open(wr, base, comm, g, ncomp, fields, restart_frames=frames, err=err)
+    if (err%raised) then
        call add_expectation(err, 'the field output of the run that wrote the checkpoint')
        return
     end if

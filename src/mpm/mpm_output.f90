@@ -1,128 +1,149 @@
-!> Field output of a material-point run: the particles (and the grid's nodal mass and velocity)
-!> in one HDF5 file, with XDMF companions so ParaView shows the particles as points.
+!> Field output of a material-point run: what a frame holds, written through the shared point
+!> writer (src/output/output_points.f90, the element writer's rows, HDF5 primitives and XDMF).
+!> Every rank passes its own particles; the file is the same on any number of ranks.
 !>
 !>   BASE.h5   /particles/NNNNNN   one group per frame, attributes step (int), increment (int),
 !>                                 step_time, total_time, count (int); datasets (rows = particles,
 !>                                 shapes as h5py shows them): coordinates (n, 3) (z = 0 in 2D),
 !>                                 V (n, 3), S (n, ncomp) global Cauchy stress in VUMAT order,
 !>                                 LE (n, ncomp), density (n), mass (n), volume (n), id (n) int32,
-!>                                 material (n) int32 (1-based *MATERIAL order), SDV (n, nsdv)
+!>                                 material (n) int32 (1-based *MATERIAL order), SDV (n, nsdv);
+!>                                 when a field request's *ELEMENT OUTPUT names them (the element
+!>                                 driver's names): FV1..FVn (n) every field variable of the scene
+!>                                 (*INITIAL CONDITIONS, TYPE=FIELD or VUSDFLD-written), TEMP (n)
+!>                                 the particle's temperature at the frame
 !>             /grid               attributes ndim, n (3), lo (3), h
 !>             /grid/NNNNNN        mass (nz, ny, nx), V (nz, ny, nx, 3) of the frame's increment
 !>                                 (nz = 1 in 2D), after the walls
 !>   BASE.xmf       particles: one Polyvertex grid per frame (temporal collection)
 !>   BASE_grid.xmf  background grid: CoRectMesh with nodal mass and V
 !>
-!> Serial (rank 0 writes what it gathered): plain HDF5 calls, no MPI-IO.
-!>
 !> Restart (mpm_checkpoint): mpm_writer_open(..., restart_frames=n) reopens BASE.h5, checks its
 !> grid against the scene's, keeps frames 0..n-1, deletes later ones (written by the
 !> interrupted run after its checkpoint) and rewrites the XDMF files from what it kept.
 module mpm_output
-  use, intrinsic :: iso_fortran_env, only: int32
-  use hdf5
+  use mpi_f08, only: MPI_Comm
   use base_kinds, only: dp
-  use error_report, only: error_t, raise_error
-  use output_files, only: file_exists, int_to_str
-  use output_hdf5, only: frame_sequence
+  use error_report, only: error_t
+  use output_points, only: point_writer_t, point_writer_open, point_writer_frame, point_writer_field, &
+       point_writer_scalar, point_writer_ints, point_writer_grid_field, point_writer_end_frame, &
+       point_writer_close, point_writer_frame_count
+  use output_files, only: int_to_str
+  use model, only: model_t
+  use model_particle_fields, only: particle_temperature
   use mpm_particles, only: particle_block_t
   use mpm_grid, only: grid_t
   implicit none
   private
 
+  !> What the frames hold beyond the fields every frame has.
+  type, public :: mpm_field_request_t
+     integer :: nsdv = 0              !< SDV columns (the largest *DEPVAR), 0: no SDV dataset
+     integer :: nfv = 0               !< FV1..FVnfv (*ELEMENT OUTPUT FV in a field request), 0: none
+     logical :: temp = .false.        !< TEMP (*ELEMENT OUTPUT TEMP in a field request)
+  end type mpm_field_request_t
+
   type, public :: mpm_writer_t
      private
-     character(len=:), allocatable :: base, h5_name
-     integer(hid_t) :: file = -1
-     integer :: n_frames = 0
-     integer :: ndim = 0, ncomp = 0, nsdv = 0
-     integer, allocatable :: counts(:)
-     real(dp), allocatable :: times(:)
+     type(point_writer_t) :: points
+     integer :: ndim = 0, ncomp = 0
+     type(mpm_field_request_t) :: req
   end type mpm_writer_t
 
-  public :: mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
+  public :: mpm_field_requests, mpm_writer_open, mpm_writer_frame, mpm_writer_close, mpm_writer_frame_count
 
 contains
 
-  subroutine check(hdferr, what)
-    integer, intent(in) :: hdferr
-    character(len=*), intent(in) :: what
-    if (hdferr < 0) call raise_error('', 0, 'HDF5 error while ' // what)
-  end subroutine check
+  !> The scene's requests: SDV always (when a material has state variables), FV and TEMP when
+  !> any step's field request names them (written in every frame then, as SDV is).
+  function mpm_field_requests(m) result(req)
+    type(model_t), intent(in) :: m
+    type(mpm_field_request_t) :: req
+    integer :: k
+
+    do k = 1, m%n_materials
+       req%nsdv = max(req%nsdv, m%materials(k)%nstatev)
+    end do
+    if (requested('FV')) then
+       req%nfv = 1
+       do k = 1, m%n_materials
+          req%nfv = max(req%nfv, m%materials(k)%nfieldv)
+       end do
+    end if
+    req%temp = requested('TEMP')
+  contains
+    logical function requested(name)
+      character(len=*), intent(in) :: name
+      integer :: s, j
+
+      requested = .false.
+      do s = 1, m%n_steps
+         if (.not. allocated(m%steps(s)%field_outputs)) cycle
+         do j = 1, size(m%steps(s)%field_outputs)
+            if (.not. allocated(m%steps(s)%field_outputs(j)%element_variables)) cycle
+            if (any(m%steps(s)%field_outputs(j)%element_variables == name)) requested = .true.
+         end do
+      end do
+    end function requested
+  end function mpm_field_requests
 
   !> Create BASE.h5 (or, with restart_frames, reopen it keeping that many frames; a problem
-  !> then goes to err when given, else stops).
-  subroutine mpm_writer_open(wr, base, g, ncomp, nsdv, restart_frames, err)
+  !> then goes to err when given, else stops). Collective over comm.
+  subroutine mpm_writer_open(wr, base, comm, g, ncomp, req, restart_frames, err)
     type(mpm_writer_t), intent(out) :: wr
     character(len=*), intent(in) :: base
+    type(MPI_Comm), intent(in) :: comm
     type(grid_t), intent(in) :: g
-    integer, intent(in) :: ncomp, nsdv
+    integer, intent(in) :: ncomp
+    type(mpm_field_request_t), intent(in) :: req
     integer, intent(in), optional :: restart_frames
     type(error_t), intent(inout), optional :: err
-    integer :: hdferr
-    integer(hid_t) :: grp
-    character(len=:), allocatable :: msg
+    character(len=8), allocatable :: shown(:)
+    integer :: j
 
-    wr%base = base
-    wr%h5_name = base // '.h5'
     wr%ndim = g%ndim
     wr%ncomp = ncomp
-    wr%nsdv = nsdv
-    allocate (wr%counts(0), wr%times(0))
-    call h5open_f(hdferr)
-    call check(hdferr, 'opening the HDF5 library')
-    if (present(restart_frames)) then
-       call reopen(wr, g, restart_frames, msg)
-       if (allocated(msg)) then
-          call mpm_writer_close(wr)
-          call raise_error(wr%h5_name, 0, msg, err)
-          return
-       end if
-       call write_xdmf(wr, g)
-       return
-    end if
-    call h5fcreate_f(wr%h5_name, H5F_ACC_TRUNC_F, wr%file, hdferr)
-    call check(hdferr, 'creating ' // wr%h5_name)
-    call write_attr_string(wr%file, 'format', 'bulkflow-mpm')
-    call h5gcreate_f(wr%file, 'particles', grp, hdferr)
-    call h5gclose_f(grp, hdferr)
-    call h5gcreate_f(wr%file, 'grid', grp, hdferr)
-    call write_attr_int(grp, 'ndim', [g%ndim])
-    call write_attr_int(grp, 'n', g%n)
-    call write_attr_real(grp, 'lo', g%lo)
-    call write_attr_real(grp, 'h', [g%h])
-    call h5gclose_f(grp, hdferr)
+    wr%req = req
+    shown = [character(len=8) :: 'V', 'density', 'mass', 'S']
+    do j = 1, req%nfv
+       shown = [character(len=8) :: shown, 'FV' // int_to_str(j)]
+    end do
+    if (req%temp) shown = [character(len=8) :: shown, 'TEMP']
+    call point_writer_open(wr%points, base, comm, 'bulkflow-mpm', g%ndim, g%n, g%lo, g%h, &
+         shown, [3, 1, 1, ncomp, (1, j = 5, size(shown))], &
+         [character(len=4) :: 'mass', 'V'], [1, 3], restart_frames, err)
   end subroutine mpm_writer_open
 
-  !> One frame: every particle of every block (in block order) and the grid.
-  subroutine mpm_writer_frame(wr, blocks, nblocks, g, step, increment, step_time, total_time)
+  !> One frame: every particle of this rank's blocks (in block order) and the grid. Collective.
+  subroutine mpm_writer_frame(wr, m, blocks, nblocks, g, step, increment, step_time, total_time)
     type(mpm_writer_t), intent(inout) :: wr
+    type(model_t), intent(in) :: m
     type(particle_block_t), intent(in) :: blocks(:)
     integer, intent(in) :: nblocks
     type(grid_t), intent(in) :: g
     integer, intent(in) :: step, increment
     real(dp), intent(in) :: step_time, total_time
-    character(len=6) :: tag
-    integer(hid_t) :: grp
-    integer :: hdferr, n, ib, p, r, nd, nsv
+    integer :: n, ib, p, r, nd, nsv, nfv, j
     real(dp), allocatable :: xyz(:, :), vel(:, :), s(:, :), le(:, :), dens(:), mass(:), vol(:), sdv(:, :)
+    real(dp), allocatable :: fv(:, :), temp(:)
     real(dp), allocatable :: gv(:, :)
-    integer(int32), allocatable :: id(:), mat(:)
+    integer, allocatable :: id(:), mat(:)
     real(dp) :: detf
-    integer, allocatable :: grown_i(:)
-    real(dp), allocatable :: grown_r(:)
 
     nd = wr%ndim
     n = sum(blocks(1:nblocks)%count)
     allocate (xyz(3, n), vel(3, n), s(wr%ncomp, n), le(wr%ncomp, n), dens(n), mass(n), vol(n), &
-         sdv(max(1, wr%nsdv), n), id(n), mat(n))
+         sdv(max(1, wr%req%nsdv), n), id(n), mat(n), fv(n, wr%req%nfv), temp(n))
     xyz = 0
     vel = 0
     sdv = 0
+    fv = 0
     r = 0
     do ib = 1, nblocks
        associate (b => blocks(ib))
-         nsv = min(size(b%state, 2), wr%nsdv)
+         nsv = min(size(b%state, 2), wr%req%nsdv)
+         nfv = min(size(b%field, 2), wr%req%nfv)
+         if (wr%req%temp) temp(r + 1:r + b%count) = particle_temperature(m, step, b%material, step_time, total_time)
          do p = 1, b%count
             r = r + 1
             xyz(1:nd, r) = b%x(p, :)
@@ -140,357 +161,43 @@ contains
             mass(r) = b%mass(p)
             dens(r) = b%mass(p) / vol(r)
             if (nsv > 0) sdv(1:nsv, r) = b%state(p, 1:nsv)
+            if (nfv > 0) fv(r, 1:nfv) = b%field(p, 1:nfv)
             id(r) = b%number(p)
             mat(r) = b%material
          end do
        end associate
     end do
-    write (tag, '(i6.6)') wr%n_frames
-    call h5gcreate_f(wr%file, 'particles/' // tag, grp, hdferr)
-    call check(hdferr, 'creating frame ' // tag)
-    call write_attr_int(grp, 'step', [step])
-    call write_attr_int(grp, 'increment', [increment])
-    call write_attr_int(grp, 'count', [n])
-    call write_attr_real(grp, 'step_time', [step_time])
-    call write_attr_real(grp, 'total_time', [total_time])
-    call write_r2(grp, 'coordinates', xyz)
-    call write_r2(grp, 'V', vel)
-    call write_r2(grp, 'S', s)
-    call write_r2(grp, 'LE', le)
-    call write_r1(grp, 'density', dens)
-    call write_r1(grp, 'mass', mass)
-    call write_r1(grp, 'volume', vol)
-    if (wr%nsdv > 0) call write_r2(grp, 'SDV', sdv)
-    call write_i1(grp, 'id', id)
-    call write_i1(grp, 'material', mat)
-    call h5gclose_f(grp, hdferr)
-    ! grid
+    call point_writer_frame(wr%points, step, increment, step_time, total_time, n)
+    call point_writer_field(wr%points, 'coordinates', xyz)
+    call point_writer_field(wr%points, 'V', vel)
+    call point_writer_field(wr%points, 'S', s)
+    call point_writer_field(wr%points, 'LE', le)
+    call point_writer_scalar(wr%points, 'density', dens)
+    call point_writer_scalar(wr%points, 'mass', mass)
+    call point_writer_scalar(wr%points, 'volume', vol)
+    if (wr%req%nsdv > 0) call point_writer_field(wr%points, 'SDV', sdv)
+    call point_writer_ints(wr%points, 'id', id)
+    call point_writer_ints(wr%points, 'material', mat)
+    do j = 1, wr%req%nfv
+       call point_writer_scalar(wr%points, 'FV' // int_to_str(j), fv(:, j))
+    end do
+    if (wr%req%temp) call point_writer_scalar(wr%points, 'TEMP', temp)
     allocate (gv(3, g%nn))
     gv = 0
     gv(1:nd, :) = g%v_new
-    call h5gcreate_f(wr%file, 'grid/' // tag, grp, hdferr)
-    ! shaped like the grid ((nz,) ny, nx[, 3] as h5py shows them) so the XDMF CoRectMesh reads them
-    call write_shaped(grp, 'mass', g%mass, [integer(hsize_t) :: g%n])
-    call write_shaped(grp, 'V', reshape(gv, [3 * g%nn]), [integer(hsize_t) :: 3, g%n])
-    call h5gclose_f(grp, hdferr)
-    call h5fflush_f(wr%file, H5F_SCOPE_GLOBAL_F, hdferr)
-    wr%n_frames = wr%n_frames + 1
-    grown_i = [wr%counts, n]
-    call move_alloc(grown_i, wr%counts)
-    grown_r = [wr%times, total_time]
-    call move_alloc(grown_r, wr%times)
-    call write_xdmf(wr, g)
+    call point_writer_grid_field(wr%points, 'mass', g%mass, 1)
+    call point_writer_grid_field(wr%points, 'V', reshape(gv, [3 * g%nn]), 3)
+    call point_writer_end_frame(wr%points)
   end subroutine mpm_writer_frame
 
   !> Frames written so far (what a checkpoint records).
   pure integer function mpm_writer_frame_count(wr)
     type(mpm_writer_t), intent(in) :: wr
-    mpm_writer_frame_count = wr%n_frames
+    mpm_writer_frame_count = point_writer_frame_count(wr%points)
   end function mpm_writer_frame_count
-
-  !> Reopen the file of an interrupted run and keep its first `keep` frames; msg is allocated
-  !> (and the file possibly left open: the caller closes it) when it cannot serve the restart.
-  subroutine reopen(wr, g, keep, msg)
-    type(mpm_writer_t), intent(inout) :: wr
-    type(grid_t), intent(in) :: g
-    integer, intent(in) :: keep
-    character(len=:), allocatable, intent(out) :: msg
-    integer(hid_t) :: parts, grid, frame
-    integer :: hdferr, f, n_found, ndim(1), n(3), count(1)
-    real(dp) :: lo(3), h(1), time(1)
-    character(len=6) :: tag
-    character(len=96) :: text
-    logical :: exists
-
-    if (.not. file_exists(wr%h5_name)) then
-       msg = 'cannot restart: the file does not exist'
-       return
-    end if
-    ! A file that is not HDF5 is reported by us, not by HDF5's error stack on stderr.
-    call h5eset_auto_f(0, hdferr)
-    call h5fopen_f(wr%h5_name, H5F_ACC_RDWR_F, wr%file, hdferr)
-    if (hdferr < 0) then
-       wr%file = -1
-       call h5eset_auto_f(1, hdferr)
-       msg = 'cannot restart: the file cannot be opened as an HDF5 file'
-       return
-    end if
-    call h5lexists_f(wr%file, 'grid', exists, hdferr)
-    if (exists) call h5lexists_f(wr%file, 'particles', exists, hdferr)
-    if (.not. exists .or. hdferr < 0) then
-       call h5eset_auto_f(1, hdferr)
-       msg = 'cannot restart: not the field output of a material-point run (no /grid, /particles)'
-       return
-    end if
-    call h5eset_auto_f(1, hdferr)
-    call h5gopen_f(wr%file, 'grid', grid, hdferr)
-    call check(hdferr, 'opening /grid')
-    call read_attr_int(grid, 'ndim', ndim)
-    call read_attr_int(grid, 'n', n)
-    call read_attr_real(grid, 'lo', lo)
-    call read_attr_real(grid, 'h', h)
-    if (ndim(1) /= g%ndim .or. any(n /= g%n) .or. any(abs(lo - g%lo) > 0) .or. abs(h(1) - g%h) > 0) then
-       write (text, '(i0,a,i0,a,i0,a,es12.5)') n(1), ' x ', n(2), ' x ', n(3), ' nodes, cell ', h(1)
-       msg = 'cannot restart: the file holds a grid of ' // trim(text)
-       write (text, '(i0,a,i0,a,i0,a,es12.5)') g%n(1), ' x ', g%n(2), ' x ', g%n(3), ' nodes, cell ', g%h
-       msg = msg // '; expected the scene''s grid of ' // trim(text)
-       call h5gclose_f(grid, hdferr)
-       return
-    end if
-    call h5gopen_f(wr%file, 'particles', parts, hdferr)
-    call check(hdferr, 'opening /particles')
-    call frame_sequence(parts, '/particles', keep, n_found, msg)
-    if (allocated(msg)) then
-       if (index(msg, 'cannot restart') /= 1) msg = 'cannot restart: ' // msg
-       call h5gclose_f(parts, hdferr)
-       call h5gclose_f(grid, hdferr)
-       return
-    end if
-    ! Frames written after the checkpoint by the interrupted run go; the restarted run writes
-    ! them again.
-    do f = keep, n_found - 1
-       write (tag, '(i6.6)') f
-       call h5ldelete_f(parts, tag, hdferr)
-       call check(hdferr, 'deleting frame /particles/' // tag)
-       call h5lexists_f(grid, tag, exists, hdferr)
-       if (exists) call h5ldelete_f(grid, tag, hdferr)
-       call check(hdferr, 'deleting frame /grid/' // tag)
-    end do
-    ! what the XDMF files list: every kept frame's particle count and time
-    deallocate (wr%counts, wr%times)
-    allocate (wr%counts(keep), wr%times(keep))
-    do f = 0, keep - 1
-       write (tag, '(i6.6)') f
-       call h5gopen_f(parts, tag, frame, hdferr)
-       call check(hdferr, 'opening frame /particles/' // tag)
-       call read_attr_int(frame, 'count', count)
-       call read_attr_real(frame, 'total_time', time)
-       call h5gclose_f(frame, hdferr)
-       wr%counts(f + 1) = count(1)
-       wr%times(f + 1) = time(1)
-    end do
-    wr%n_frames = keep
-    call h5gclose_f(parts, hdferr)
-    call h5gclose_f(grid, hdferr)
-    call h5fflush_f(wr%file, H5F_SCOPE_GLOBAL_F, hdferr)
-  end subroutine reopen
 
   subroutine mpm_writer_close(wr)
     type(mpm_writer_t), intent(inout) :: wr
-    integer :: hdferr
-    if (wr%file /= -1) then
-       call h5fclose_f(wr%file, hdferr)
-       wr%file = -1
-    end if
+    call point_writer_close(wr%points)
   end subroutine mpm_writer_close
-
-  subroutine write_xdmf(wr, g)
-    type(mpm_writer_t), intent(in) :: wr
-    type(grid_t), intent(in) :: g
-    integer :: u, i, slash
-    character(len=6) :: tag
-    character(len=:), allocatable :: h5
-    character(len=64) :: dims, gdims
-
-    slash = index(wr%h5_name, '/', back=.true.)
-    h5 = wr%h5_name(slash + 1:)
-    open (newunit=u, file=wr%base // '.xmf', status='replace', action='write')
-    write (u, '(a)') '<?xml version="1.0" ?>'
-    write (u, '(a)') '<Xdmf Version="3.0"><Domain>'
-    write (u, '(a)') '<Grid Name="particles" GridType="Collection" CollectionType="Temporal">'
-    do i = 1, wr%n_frames
-       write (tag, '(i6.6)') i - 1
-       write (dims, '(i0)') wr%counts(i)
-       write (u, '(a)') '<Grid Name="particles_' // tag // '" GridType="Uniform">'
-       write (u, '(a,es24.16,a)') '<Time Value="', wr%times(i), '"/>'
-       write (u, '(a)') '<Topology TopologyType="Polyvertex" NumberOfElements="' // trim(dims) // '"/>'
-       write (u, '(a)') '<Geometry GeometryType="XYZ"><DataItem Dimensions="' // trim(dims) // &
-            ' 3" NumberType="Float" Precision="8" Format="HDF">' // h5 // ':/particles/' // tag // &
-            '/coordinates</DataItem></Geometry>'
-       call attribute(u, 'V', 'Vector', trim(dims) // ' 3', h5 // ':/particles/' // tag // '/V')
-       call attribute(u, 'density', 'Scalar', trim(dims), h5 // ':/particles/' // tag // '/density')
-       call attribute(u, 'mass', 'Scalar', trim(dims), h5 // ':/particles/' // tag // '/mass')
-       write (gdims, '(i0,a,i0)') wr%counts(i), ' ', wr%ncomp
-       call attribute(u, 'S', 'Matrix', trim(gdims), h5 // ':/particles/' // tag // '/S')
-       write (u, '(a)') '</Grid>'
-    end do
-    write (u, '(a)') '</Grid></Domain></Xdmf>'
-    close (u)
-    ! the background grid
-    open (newunit=u, file=wr%base // '_grid.xmf', status='replace', action='write')
-    write (u, '(a)') '<?xml version="1.0" ?>'
-    write (u, '(a)') '<Xdmf Version="3.0"><Domain>'
-    write (u, '(a)') '<Grid Name="grid" GridType="Collection" CollectionType="Temporal">'
-    ! 2D grids too as a 3D CoRectMesh one node thick (ParaView's XDMF reader then takes the
-    ! vector attribute; with 2DCoRectMesh it failed to read it)
-    write (gdims, '(i0,a,i0,a,i0)') g%n(3), ' ', g%n(2), ' ', g%n(1)
-    do i = 1, wr%n_frames
-       write (tag, '(i6.6)') i - 1
-       write (u, '(a)') '<Grid Name="grid_' // tag // '" GridType="Uniform">'
-       write (u, '(a,es24.16,a)') '<Time Value="', wr%times(i), '"/>'
-       write (u, '(a)') '<Topology TopologyType="3DCoRectMesh" Dimensions="' // trim(gdims) // '"/>'
-       write (u, '(a)') '<Geometry GeometryType="ORIGIN_DXDYDZ">'
-       write (u, '(a,3es24.16,a)') '<DataItem Dimensions="3" Format="XML">', g%lo(3), g%lo(2), g%lo(1), &
-            '</DataItem>'
-       write (u, '(a,3es24.16,a)') '<DataItem Dimensions="3" Format="XML">', g%h, g%h, g%h, '</DataItem>'
-       write (u, '(a)') '</Geometry>'
-       call attribute(u, 'mass', 'Scalar', trim(gdims), h5 // ':/grid/' // tag // '/mass', 'Node')
-       call attribute(u, 'V', 'Vector', trim(gdims) // ' 3', h5 // ':/grid/' // tag // '/V', 'Node')
-       write (u, '(a)') '</Grid>'
-    end do
-    write (u, '(a)') '</Grid></Domain></Xdmf>'
-    close (u)
-  end subroutine write_xdmf
-
-  subroutine attribute(u, name, kind, dims, path, center)
-    integer, intent(in) :: u
-    character(len=*), intent(in) :: name, kind, dims, path
-    character(len=*), intent(in), optional :: center
-    character(len=:), allocatable :: c
-    c = 'Node'
-    if (present(center)) c = center
-    write (u, '(a)') '<Attribute Name="' // name // '" AttributeType="' // kind // '" Center="' // c // &
-         '"><DataItem Dimensions="' // dims // '" NumberType="Float" Precision="8" Format="HDF">' // &
-         path // '</DataItem></Attribute>'
-  end subroutine attribute
-
-  subroutine write_r2(loc, name, a)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(dp), intent(in) :: a(:, :)
-    integer(hsize_t) :: dims(2)
-    integer(hid_t) :: space, dset
-    integer :: hdferr
-    dims = shape(a, kind=hsize_t)
-    call h5screate_simple_f(2, dims, space, hdferr)
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, hdferr)
-    call check(hdferr, 'creating dataset ' // name)
-    if (size(a) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, a, dims, hdferr)
-    call check(hdferr, 'writing dataset ' // name)
-    call h5dclose_f(dset, hdferr)
-    call h5sclose_f(space, hdferr)
-  end subroutine write_r2
-
-  !> A flat buffer written as a dataset of Fortran shape dims (h5py shows it reversed).
-  subroutine write_shaped(loc, name, a, dims)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(dp), intent(in) :: a(:)
-    integer(hsize_t), intent(in) :: dims(:)
-    integer(hid_t) :: space, dset
-    integer :: hdferr
-    call h5screate_simple_f(size(dims), dims, space, hdferr)
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, hdferr)
-    call check(hdferr, 'creating dataset ' // name)
-    if (size(a) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, a, dims, hdferr)
-    call check(hdferr, 'writing dataset ' // name)
-    call h5dclose_f(dset, hdferr)
-    call h5sclose_f(space, hdferr)
-  end subroutine write_shaped
-
-  subroutine write_r1(loc, name, a)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(dp), intent(in) :: a(:)
-    call write_shaped(loc, name, a, shape(a, kind=hsize_t))
-  end subroutine write_r1
-
-  subroutine write_i1(loc, name, a)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer(int32), intent(in) :: a(:)
-    integer(hsize_t) :: dims(1)
-    integer(hid_t) :: space, dset
-    integer :: hdferr
-    dims = shape(a, kind=hsize_t)
-    call h5screate_simple_f(1, dims, space, hdferr)
-    call h5dcreate_f(loc, name, H5T_NATIVE_INTEGER, space, dset, hdferr)
-    call check(hdferr, 'creating dataset ' // name)
-    if (size(a) > 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, a, dims, hdferr)
-    call check(hdferr, 'writing dataset ' // name)
-    call h5dclose_f(dset, hdferr)
-    call h5sclose_f(space, hdferr)
-  end subroutine write_i1
-
-  subroutine write_attr_int(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(in) :: v(:)
-    integer(hsize_t) :: dims(1)
-    integer(hid_t) :: space, attr
-    integer :: hdferr
-    dims = size(v)
-    call h5screate_simple_f(1, dims, space, hdferr)
-    call h5acreate_f(loc, name, H5T_NATIVE_INTEGER, space, attr, hdferr)
-    call h5awrite_f(attr, H5T_NATIVE_INTEGER, v, dims, hdferr)
-    call check(hdferr, 'writing attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-    call h5sclose_f(space, hdferr)
-  end subroutine write_attr_int
-
-  subroutine read_attr_int(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(out) :: v(:)
-    integer(hsize_t) :: dims(1)
-    integer(hid_t) :: attr
-    integer :: hdferr
-    dims = size(v)
-    v = 0
-    call h5aopen_f(loc, name, attr, hdferr)
-    call check(hdferr, 'opening attribute ' // name)
-    call h5aread_f(attr, H5T_NATIVE_INTEGER, v, dims, hdferr)
-    call check(hdferr, 'reading attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-  end subroutine read_attr_int
-
-  subroutine read_attr_real(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(dp), intent(out) :: v(:)
-    integer(hsize_t) :: dims(1)
-    integer(hid_t) :: attr
-    integer :: hdferr
-    dims = size(v)
-    v = 0
-    call h5aopen_f(loc, name, attr, hdferr)
-    call check(hdferr, 'opening attribute ' // name)
-    call h5aread_f(attr, H5T_NATIVE_DOUBLE, v, dims, hdferr)
-    call check(hdferr, 'reading attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-  end subroutine read_attr_real
-
-  subroutine write_attr_real(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(dp), intent(in) :: v(:)
-    integer(hsize_t) :: dims(1)
-    integer(hid_t) :: space, attr
-    integer :: hdferr
-    dims = size(v)
-    call h5screate_simple_f(1, dims, space, hdferr)
-    call h5acreate_f(loc, name, H5T_NATIVE_DOUBLE, space, attr, hdferr)
-    call h5awrite_f(attr, H5T_NATIVE_DOUBLE, v, dims, hdferr)
-    call check(hdferr, 'writing attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-    call h5sclose_f(space, hdferr)
-  end subroutine write_attr_real
-
-  subroutine write_attr_string(loc, name, text)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name, text
-    integer(hsize_t) :: dims(1)
-    integer(hid_t) :: space, attr, stype
-    integer :: hdferr
-    dims = 1
-    call h5tcopy_f(H5T_NATIVE_CHARACTER, stype, hdferr)
-    call h5tset_size_f(stype, int(len(text), size_t), hdferr)
-    call h5screate_f(H5S_SCALAR_F, space, hdferr)
-    call h5acreate_f(loc, name, stype, space, attr, hdferr)
-    call h5awrite_f(attr, stype, text, dims, hdferr)
-    call check(hdferr, 'writing attribute ' // name)
-    call h5aclose_f(attr, hdferr)
-    call h5sclose_f(space, hdferr)
-    call h5tclose_f(stype, hdferr)
-  end subroutine write_attr_string
 end module mpm_output

@@ -1,22 +1,18 @@
 !> What an MPM run reports: the header and the summary on standard output, the progress line,
 !> the history rows (masses, energies, centre of mass, wall forces; sums over ranks in rank
-!> order) and the field frames (rank 0 gathers every rank's blocks and writes them through
-!> mpm_output).
+!> order) and the field frames (every rank writes its own blocks through mpm_output).
 module mpm_report
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
-  use mpi_f08, only: MPI_Comm
   use base_kinds, only: dp
   use model, only: model_t
   use mpm_state, only: mpm_state_t, mpm_effects_t, n_fx, fx_names, sum_over_ranks, max_over_ranks
-  use mpm_particles, only: particle_block_t, block_allocate
   use mpm_output, only: mpm_writer_t, mpm_writer_frame
   use output_timer, only: timer_report, clock_text
   use output_history, only: history_t, history_row
-  use parallel_comm, only: comm_send, comm_recv
   implicit none
   private
 
-  public :: header, summary, progress_line, history_columns, measure, write_history, write_frame, gather_blocks
+  public :: header, summary, progress_line, history_columns, measure, write_history, write_frame
 
 contains
 
@@ -39,118 +35,16 @@ contains
     flush (output_unit)
   end subroutine progress_line
 
-  !> A field frame: rank 0 gathers every rank's blocks (in rank order) and writes them.
-  subroutine write_frame(st, wr, step, step_time)
+  !> A field frame: every rank writes its own blocks (collective; rows in rank order).
+  subroutine write_frame(m, st, wr, step, step_time)
+    type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(mpm_writer_t), intent(inout) :: wr
     integer, intent(in) :: step
     real(dp), intent(in) :: step_time
-    type(particle_block_t), allocatable :: all(:)
-    integer :: nall
 
-    if (st%nranks == 1) then
-       call mpm_writer_frame(wr, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time)
-       return
-    end if
-    allocate (all(st%nblocks + 16))
-    call gather_blocks(st, all, nall)
-    if (st%rank == 0) call mpm_writer_frame(wr, all, nall, st%g, step, st%increment, step_time, st%total_time)
+    call mpm_writer_frame(wr, m, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time)
   end subroutine write_frame
-
-  !> Rank 0 receives copies of the other ranks' blocks (what the writer reads of them).
-  subroutine gather_blocks(st, all, nall)
-    type(mpm_state_t), intent(in) :: st
-    type(particle_block_t), allocatable, intent(inout) :: all(:)   !< allocated by the caller
-    integer, intent(out) :: nall
-    integer :: r, k, nb(1), head(5), c, nsv, nfv
-
-    nall = 0
-    if (st%rank /= 0) then
-       nb(1) = st%nblocks
-       call comm_send(st%comm, nb, 0, 1)
-       do k = 1, st%nblocks
-          associate (b => st%blocks(k))
-            c = b%count
-            head = [c, b%material, size(b%state, 2), size(b%field, 2), 0]
-            call comm_send(st%comm, head, 0, 2)
-            call comm_send(st%comm, b%number(1:c), 0, 3)
-            call comm_send(st%comm, packed_block(b, st%nd, st%nc), 0, 4)
-          end associate
-       end do
-       return
-    end if
-    all(1:st%nblocks) = st%blocks(1:st%nblocks)
-    nall = st%nblocks
-    do r = 1, st%nranks - 1
-       call comm_recv(st%comm, nb, r, 1)
-       do k = 1, nb(1)
-          call comm_recv(st%comm, head, r, 2)
-          c = head(1)
-          nsv = head(3)
-          nfv = head(4)
-          if (nall == size(all)) call grow_list(all, nall)
-          nall = nall + 1
-          call block_allocate(all(nall), c, st%nd, st%nc, nsv, nfv, 1)
-          all(nall)%material = head(2)
-          call comm_recv(st%comm, all(nall)%number(1:c), r, 3)
-          call unpack_block(st%comm, r, st%nd, st%nc, nsv, all(nall))
-       end do
-    end do
-  end subroutine gather_blocks
-
-  !> What the writer reads of a block, in one array: x, v, σ, LE, F, V0, m, SDV, half-length.
-  function packed_block(b, nd, nc) result(buf)
-    type(particle_block_t), intent(in) :: b
-    integer, intent(in) :: nd, nc
-    real(dp), allocatable :: buf(:)
-    integer :: c, nsv, off
-
-    c = b%count
-    nsv = size(b%state, 2)
-    allocate (buf(c * (2 * nd + 2 * nc + nd * nd + 2 + nsv) + 1))
-    off = 0
-    buf(off + 1:off + c * nd) = reshape(b%x, [c * nd]); off = off + c * nd
-    buf(off + 1:off + c * nd) = reshape(b%v, [c * nd]); off = off + c * nd
-    buf(off + 1:off + c * nc) = reshape(b%stress_global, [c * nc]); off = off + c * nc
-    buf(off + 1:off + c * nc) = reshape(b%log_strain, [c * nc]); off = off + c * nc
-    buf(off + 1:off + c * nd * nd) = reshape(b%f, [c * nd * nd]); off = off + c * nd * nd
-    buf(off + 1:off + c) = b%vol0; off = off + c
-    buf(off + 1:off + c) = b%mass; off = off + c
-    buf(off + 1:off + c * nsv) = reshape(b%state, [c * nsv]); off = off + c * nsv
-    buf(off + 1) = b%half
-  end function packed_block
-
-  !> Receive a packed_block from rank r into b (allocated for its count).
-  subroutine unpack_block(comm, r, nd, nc, nsv, b)
-    type(MPI_Comm), intent(in) :: comm
-    integer, intent(in) :: r, nd, nc, nsv
-    type(particle_block_t), intent(inout) :: b
-    real(dp), allocatable :: buf(:)
-    integer :: c, off
-
-    c = b%count
-    allocate (buf(c * (2 * nd + 2 * nc + nd * nd + 2 + nsv) + 1))
-    call comm_recv(comm, buf, r, 4)
-    off = 0
-    b%x = reshape(buf(off + 1:off + c * nd), [c, nd]); off = off + c * nd
-    b%v = reshape(buf(off + 1:off + c * nd), [c, nd]); off = off + c * nd
-    b%stress_global = reshape(buf(off + 1:off + c * nc), [c, nc]); off = off + c * nc
-    b%log_strain = reshape(buf(off + 1:off + c * nc), [c, nc]); off = off + c * nc
-    b%f = reshape(buf(off + 1:off + c * nd * nd), [c, nd, nd]); off = off + c * nd * nd
-    b%vol0 = buf(off + 1:off + c); off = off + c
-    b%mass = buf(off + 1:off + c); off = off + c
-    b%state = reshape(buf(off + 1:off + c * nsv), [c, nsv]); off = off + c * nsv
-    b%half = buf(off + 1)
-  end subroutine unpack_block
-
-  subroutine grow_list(list, n)
-    type(particle_block_t), allocatable, intent(inout) :: list(:)
-    integer, intent(in) :: n
-    type(particle_block_t), allocatable :: grown(:)
-    allocate (grown(2 * n + 16))
-    grown(1:n) = list(1:n)
-    call move_alloc(grown, list)
-  end subroutine grow_list
 
   !> The history's columns: the fixed ones, then three force components per wall.
   subroutine history_columns(m, columns)

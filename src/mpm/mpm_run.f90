@@ -27,14 +27,15 @@ module mpm_run
   use mpm_stress_update, only: stress_update
   use mpm_flow, only: guard_particles, outflow, inflow
   use mpm_report, only: header, summary, progress_line, history_columns, measure, write_history, write_frame
-  use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_close, mpm_writer_frame_count
+  use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_close, mpm_writer_frame_count, &
+       mpm_field_request_t, mpm_field_requests
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, &
        mpm_restart_outputs
   use output_timer, only: timer_start, timer_stop
   use output_collective, only: stop_agreed_error
   use output_history, only: history_t, history_open, history_close, history_row_count
   use output_schedule, only: output_schedule_t, field_schedule, history_schedule, schedule_due, schedule_advance, &
-       schedule_resume
+       schedule_resume, schedule_next_point
   use parallel_comm, only: comm_rank, comm_size
   implicit none
   private
@@ -65,29 +66,27 @@ contains
     type(history_t) :: hist
     type(schedule_t) :: sch
     character(len=32), allocatable :: columns(:)
-    real(dp) :: period, eps, sim_start
-    integer :: s, k, nsdv, first_step
+    real(dp) :: period, eps, sim_start, t_point
+    integer :: s, first_step
+    type(mpm_field_request_t) :: fields
     integer(int64) :: clock_last, clock_now, clock_rate, clock_start
-    logical :: stop_now, resumed
+    logical :: stop_now, resumed, on_point
 
     st%comm = comm
     st%rank = comm_rank(comm)
     st%nranks = comm_size(comm)
     call mpm_setup_run(m, st, fx)
-    nsdv = 0
-    do k = 1, m%n_materials
-       nsdv = max(nsdv, m%materials(k)%nstatev)
-    end do
+    fields = mpm_field_requests(m)
     if (st%rank == 0) call header(m, st, fx, base)
     call history_columns(m, columns)
     resumed = .false.
     if (present(restart)) resumed = restart
     first_step = 1
     if (resumed) then
-       call resume(m, st, base, nsdv, columns, wr, hist, sch)
+       call resume(m, st, base, fields, columns, wr, hist, sch)
        first_step = st%step
     else
-       if (st%rank == 0) call mpm_writer_open(wr, base, st%g, st%nc, nsdv)
+       call mpm_writer_open(wr, base, comm, st%g, st%nc, fields)
        call history_open(hist, base // '_history.csv', columns, comm)
        sch%last_row_time = 0
        sch%last_row_out = 0
@@ -120,9 +119,14 @@ contains
           call stable_increment(st, m%mpm%steps(st%step)%cfl, m%mpm%cell)
           st%dt = min(st%dt_stable, period - st%step_time)
           if (m%steps(s)%dt_fixed > 0) st%dt = min(m%steps(s)%dt_fixed, period - st%step_time)
+          ! TIME POINTS=: as the element driver, the increment is cut to end on the next listed time
+          t_point = min(schedule_next_point(sch%field, st%step_time), schedule_next_point(sch%history, st%step_time))
+          on_point = t_point - st%step_time <= st%dt
+          if (on_point) st%dt = t_point - st%step_time
           st%particle_steps = st%particle_steps + sum(st%blocks(1:st%nblocks)%count)
           call increment(m, st, fx)
           st%step_time = st%step_time + st%dt
+          if (on_point) st%step_time = t_point
           st%total_time = st%total_time + st%dt
           st%increment = st%increment + 1
           st%step_increment = st%step_increment + 1
@@ -154,7 +158,7 @@ contains
     end do
     call system_clock(clock_now)
     st%loop_seconds = real(clock_now - clock_start, dp) / real(clock_rate, dp)
-    if (st%rank == 0) call mpm_writer_close(wr)
+    call mpm_writer_close(wr)
     call history_close(hist)
     call summary(m, st, fx, stop_now)
   end subroutine mpm_run_scene
@@ -212,7 +216,7 @@ contains
        call schedule_advance(sch%history, st%step_time)
     end if
     if (field_due) then
-       call write_frame(st, wr, st%step, st%step_time)
+       call write_frame(m, st, wr, st%step, st%step_time)
        call schedule_advance(sch%field, st%step_time)
     end if
     if (st%step_increment == 0) return
@@ -225,7 +229,7 @@ contains
        call measure(st)
        call write_history(m, st, hist, sch%last_row_time, sch%last_row_out)
     end if
-    if (stop_now .and. .not. field_due) call write_frame(st, wr, st%step, st%step_time)
+    if (stop_now .and. .not. field_due) call write_frame(m, st, wr, st%step, st%step_time)
   end subroutine increment_outputs
 
   ! ------------------------------------------------------------------------------ checkpoint hooks
@@ -281,11 +285,11 @@ contains
   !> checkpoint's, the outputs are reopened at it. A restart that cannot continue stops here on
   !> every rank with the reason (stop_agreed_error). particle_steps is not restored: the
   !> throughput report is this run's.
-  subroutine resume(m, st, base, nsdv, columns, wr, hist, sch)
+  subroutine resume(m, st, base, fields, columns, wr, hist, sch)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     character(len=*), intent(in) :: base
-    integer, intent(in) :: nsdv
+    type(mpm_field_request_t), intent(in) :: fields
     character(len=*), intent(in) :: columns(:)
     type(mpm_writer_t), intent(inout) :: wr
     type(history_t), intent(inout) :: hist
@@ -294,7 +298,7 @@ contains
     type(error_t) :: err
 
     call mpm_checkpoint_load(base, st%comm, m, st%nd, st%nc, st%nsup, st%blocks, st%nblocks, sv, err)
-    if (.not. err%raised) call mpm_restart_outputs(base, st%comm, st%g, st%nc, nsdv, columns, sv%frames, &
+    if (.not. err%raised) call mpm_restart_outputs(base, st%comm, st%g, st%nc, fields, columns, sv%frames, &
          sv%rows, wr, hist, err)
     if (err%raised) call stop_agreed_error(st%comm, err)
     st%step = sv%step

@@ -45,16 +45,15 @@ module output_hdf5
   use output_hdf5_basics, only: hdf5_error_context, check, create_dataset, write_attr_int, &
        write_attr_real, write_attr_string
   use output_hdf5_rows, only: write_rows_real, write_rows_int
-  ! frame_sequence is re-exported: src/mpm/mpm_output.f90 reopens its particle frames with it.
-  use output_hdf5_frames, only: reopen_frames, frame_sequence, frame_path, new_xdmf_frame, &
-       move_frame, coordinates_name
+  use output_hdf5_frames, only: reopen_frames, frame_path, new_xdmf_frame, &
+       grow_frames, coordinates_name
   implicit none
   private
 
   public :: field_writer_t
   public :: field_writer_open, field_writer_frame, field_writer_end_frame
   public :: field_writer_coordinates, field_writer_node_field, field_writer_element_field
-  public :: field_writer_close, field_writer_frame_count, frame_sequence
+  public :: field_writer_close, field_writer_frame_count
 
   integer, parameter :: format_version = 1
 
@@ -249,9 +248,8 @@ contains
     real(dp), intent(in) :: step_time
     real(dp), intent(in) :: total_time
     integer, intent(in) :: increment      !< increment number
-    type(xdmf_frame_t), allocatable :: grown(:)
     integer(hid_t) :: gcpl
-    integer :: hdferr, i
+    integer :: hdferr
     character(len=6) :: tag
 
     call require_open(w, 'field_writer_frame')
@@ -272,13 +270,7 @@ contains
     call write_attr_real(w%frame_group, 'step_time', step_time)
     call write_attr_real(w%frame_group, 'total_time', total_time)
 
-    if (w%n_frames == size(w%frames)) then
-       allocate (grown(2 * size(w%frames)))
-       do i = 1, w%n_frames
-          call move_frame(w%frames(i), grown(i))
-       end do
-       call move_alloc(grown, w%frames)
-    end if
+    call grow_frames(w%frames, w%n_frames)
     w%n_frames = w%n_frames + 1
     call new_xdmf_frame(w%frames(w%n_frames), tag, total_time)
     w%frame_open = .true.

@@ -10,8 +10,9 @@ module output_hdf5_basics
   private
 
   public :: hdf5_error_context, check
-  public :: dataset_space, create_dataset, dataset_rows, block_spaces
+  public :: dataset_space, create_dataset, create_shaped_dataset, dataset_rows, block_spaces
   public :: write_attr_int, write_attr_real, write_attr_string, read_attr_real, read_attr_string
+  public :: write_attr_ints, write_attr_reals, read_attr_ints, read_attr_reals
 
   !> The file named in messages of failed HDF5 calls (set by each public procedure of
   !> output_hdf5): such failures are fatal.
@@ -53,14 +54,27 @@ contains
     integer, intent(in) :: ncomp
     integer, intent(in) :: nrows
     integer(hid_t), intent(out) :: dset
+
+    if (ncomp == 1) then
+       call create_shaped_dataset(loc, name, file_type, [int(nrows, hsize_t)], dset)
+    else
+       call create_shaped_dataset(loc, name, file_type, [int(ncomp, hsize_t), int(nrows, hsize_t)], dset)
+    end if
+  end subroutine create_dataset
+
+  !> A dataset of any Fortran shape `dims` (h5py shows it reversed), contiguous, never filled:
+  !> the particle fields that keep a second dimension of one component (SDV of one state
+  !> variable) and the nodal fields of a structured grid.
+  subroutine create_shaped_dataset(loc, name, file_type, dims, dset)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer(hid_t), intent(in) :: file_type
+    integer(hsize_t), intent(in) :: dims(:)
+    integer(hid_t), intent(out) :: dset
     integer(hid_t) :: space, dcpl
     integer :: hdferr
 
-    if (ncomp == 1) then
-       call h5screate_simple_f(1, [int(nrows, hsize_t)], space, hdferr)
-    else
-       call h5screate_simple_f(2, [int(ncomp, hsize_t), int(nrows, hsize_t)], space, hdferr)
-    end if
+    call h5screate_simple_f(size(dims), dims, space, hdferr)
     call check(hdferr, 'creating the dataspace of ' // name)
     call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, hdferr)
     call h5pset_fill_time_f(dcpl, H5D_FILL_TIME_NEVER_F, hdferr)
@@ -68,7 +82,7 @@ contains
     call check(hdferr, 'creating dataset ' // name)
     call h5pclose_f(dcpl, hdferr)
     call h5sclose_f(space, hdferr)
-  end subroutine create_dataset
+  end subroutine create_shaped_dataset
 
   !> Number of rows of a dataset (its last Fortran-order dimension).
   integer function dataset_rows(dset)
@@ -82,7 +96,8 @@ contains
 
   !> File and memory dataspaces of the block first..first+count-1; with count = 0 both
   !> selections are empty (a one-row memory space selecting nothing), so that a rank
-  !> without rows still joins the collective transfer.
+  !> without rows still joins the collective transfer. The dataset's rank (not ncomp) decides
+  !> between rows of one value and rows of ncomp values: a (1, nrows) dataset is 2-D.
   subroutine block_spaces(dset, ncomp, first, count, file_space, mem_space)
     integer(hid_t), intent(in) :: dset
     integer, intent(in) :: ncomp
@@ -90,11 +105,13 @@ contains
     integer, intent(in) :: count
     integer(hid_t), intent(out) :: file_space
     integer(hid_t), intent(out) :: mem_space
-    integer :: hdferr
+    integer(hsize_t) :: dims(2)
+    integer :: hdferr, ndims
 
+    call dataset_space(dset, ndims, dims)
     call h5dget_space_f(dset, file_space, hdferr)
     call check(hdferr, 'getting a file dataspace')
-    if (ncomp == 1) then
+    if (ndims == 1) then
        call h5screate_simple_f(1, [int(max(count, 1), hsize_t)], mem_space, hdferr)
     else
        call h5screate_simple_f(2, [int(ncomp, hsize_t), int(max(count, 1), hsize_t)], mem_space, hdferr)
@@ -103,7 +120,7 @@ contains
     if (count == 0) then
        call h5sselect_none_f(file_space, hdferr)
        call h5sselect_none_f(mem_space, hdferr)
-    else if (ncomp == 1) then
+    else if (ndims == 1) then
        call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, [int(first - 1, hsize_t)], &
             [int(count, hsize_t)], hdferr)
     else
@@ -174,6 +191,85 @@ contains
     call h5sclose_f(space, hdferr)
     call h5tclose_f(stype, hdferr)
   end subroutine write_attr_string
+
+  !> Attributes of a 1-D dataspace of size(values) (a point writer's frame and grid
+  !> attributes: h5py shows arrays, also of one value).
+  subroutine write_attr_ints(loc, name, values)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: values(:)
+    integer, target :: v(size(values))
+
+    v = values
+    call write_attr_array(loc, name, H5T_STD_I32LE, H5T_NATIVE_INTEGER, size(values), c_loc(v))
+  end subroutine write_attr_ints
+
+  subroutine write_attr_reals(loc, name, values)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: values(:)
+    real(dp), target :: v(size(values))
+
+    v = values
+    call write_attr_array(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, size(values), c_loc(v))
+  end subroutine write_attr_reals
+
+  subroutine write_attr_array(loc, name, file_type, mem_type, n, ptr)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer(hid_t), intent(in) :: file_type
+    integer(hid_t), intent(in) :: mem_type
+    integer, intent(in) :: n
+    type(c_ptr), intent(in) :: ptr
+    integer(hid_t) :: space, attr
+    integer :: hdferr
+
+    call h5screate_simple_f(1, [int(n, hsize_t)], space, hdferr)
+    call h5acreate_f(loc, name, file_type, space, attr, hdferr)
+    call check(hdferr, 'creating attribute ' // name)
+    call h5awrite_f(attr, mem_type, ptr, hdferr)
+    call check(hdferr, 'writing attribute ' // name)
+    call h5aclose_f(attr, hdferr)
+    call h5sclose_f(space, hdferr)
+  end subroutine write_attr_array
+
+  !> An integer attribute of size(values) values (what write_attr_ints wrote).
+  subroutine read_attr_ints(loc, name, values)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: values(:)
+    integer, target :: v(size(values))
+
+    call read_attr_array(loc, name, H5T_NATIVE_INTEGER, c_loc(v))
+    values = v
+  end subroutine read_attr_ints
+
+  subroutine read_attr_reals(loc, name, values)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    real(dp), intent(out) :: values(:)
+    real(dp), target :: v(size(values))
+
+    call read_attr_array(loc, name, H5T_NATIVE_DOUBLE, c_loc(v))
+    values = v
+  end subroutine read_attr_reals
+
+  subroutine read_attr_array(loc, name, mem_type, ptr)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer(hid_t), intent(in) :: mem_type
+    type(c_ptr), intent(in) :: ptr
+    type(c_ptr) :: p
+    integer(hid_t) :: attr
+    integer :: hdferr
+
+    p = ptr
+    call h5aopen_f(loc, name, attr, hdferr)
+    call check(hdferr, 'opening attribute ' // name)
+    call h5aread_f(attr, mem_type, p, hdferr)
+    call check(hdferr, 'reading attribute ' // name)
+    call h5aclose_f(attr, hdferr)
+  end subroutine read_attr_array
 
   subroutine read_attr_real(loc, name, value)
     integer(hid_t), intent(in) :: loc

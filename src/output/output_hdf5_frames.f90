@@ -11,7 +11,7 @@ module output_hdf5_frames
   implicit none
   private
 
-  public :: reopen_frames, frame_sequence, frame_path, new_xdmf_frame, move_frame
+  public :: reopen_frames, frame_sequence, frame_path, new_xdmf_frame, move_frame, grow_frames
 
   !> Dataset name reserved for the current coordinates of a frame.
   character(len=*), parameter, public :: coordinates_name = 'coordinates'
@@ -176,12 +176,28 @@ contains
     frame%n_attributes = 0
   end subroutine new_xdmf_frame
 
+  !> Room for one more frame description after the first n_used (the list doubles when full).
+  subroutine grow_frames(frames, n_used)
+    type(xdmf_frame_t), allocatable, intent(inout) :: frames(:)
+    integer, intent(in) :: n_used
+    type(xdmf_frame_t), allocatable :: grown(:)
+    integer :: i
+
+    if (n_used < size(frames)) return
+    allocate (grown(2 * size(frames)))
+    do i = 1, n_used
+       call move_frame(frames(i), grown(i))
+    end do
+    call move_alloc(grown, frames)
+  end subroutine grow_frames
+
   !> Move a frame description (with its allocatable components) without copying the strings.
   subroutine move_frame(from, to)
     type(xdmf_frame_t), intent(inout) :: from
     type(xdmf_frame_t), intent(inout) :: to
 
     to%time = from%time
+    to%n_points = from%n_points
     to%n_attributes = from%n_attributes
     call move_alloc(from%name, to%name)
     call move_alloc(from%geometry, to%geometry)

@@ -12,7 +12,7 @@ module output_hdf5_rows
   implicit none
   private
 
-  public :: write_rows_real, write_rows_int
+  public :: write_rows_real, write_rows_int, write_whole_real
 
 contains
 
@@ -179,5 +179,34 @@ contains
     call h5sclose_f(mem_space, hdferr)
     call h5sclose_f(file_space, hdferr)
   end subroutine write_rows_int
+
+  !> Collective write of a whole dataset that every rank holds alike (the nodal fields of a
+  !> background grid summed over the ranks): `writer` passes all of it in Fortran element
+  !> order, the other ranks take part with empty selections.
+  subroutine write_whole_real(xfer, dset, values, writer)
+    integer(hid_t), intent(in) :: xfer       !< collective transfer property list
+    integer(hid_t), intent(in) :: dset
+    real(dp), intent(in), target :: values(:)
+    logical, intent(in) :: writer
+    real(dp), target :: idle(1)
+    integer(hid_t) :: file_space, mem_space
+    integer :: hdferr
+
+    call h5dget_space_f(dset, file_space, hdferr)
+    call check(hdferr, 'getting a file dataspace')
+    call h5screate_simple_f(1, [int(max(size(values), 1), hsize_t)], mem_space, hdferr)
+    call check(hdferr, 'creating a memory dataspace')
+    idle = 0.0_dp
+    if (writer .and. size(values) > 0) then
+       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(values), hdferr, mem_space, file_space, xfer)
+    else
+       call h5sselect_none_f(file_space, hdferr)
+       call h5sselect_none_f(mem_space, hdferr)
+       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(idle), hdferr, mem_space, file_space, xfer)
+    end if
+    call check(hdferr, 'writing a dataset')
+    call h5sclose_f(mem_space, hdferr)
+    call h5sclose_f(file_space, hdferr)
+  end subroutine write_whole_real
 
 end module output_hdf5_rows

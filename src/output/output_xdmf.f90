@@ -6,6 +6,11 @@
 !>   Time = total time, Topology (Quadrilateral | Hexahedron) from /mesh/connectivity,
 !>   Geometry XYZ from /mesh/coordinates or the frame's own current coordinates, and one
 !>   Attribute per field dataset of the frame.
+!>   Two more topologies serve point writers (output_points, the MPM's particles): Polyvertex,
+!>   a cloud of points whose number changes from frame to frame (each point its own cell), and
+!>   3DCoRectMesh, a uniform grid given by origin and spacing (no geometry dataset). A 2-D grid
+!>   is written as a 3-D one a node thick: with 2DCoRectMesh ParaView's XDMF reader failed to
+!>   read a vector attribute.
 !>
 !> Attribute types: 1 component -> Scalar, 3 -> Vector, anything else -> Matrix with
 !> Dimensions "n ncomp". Why not Tensor6 for 6-component stresses: readers convert Tensor6
@@ -40,6 +45,7 @@ module output_xdmf
   !> One output frame: a grid of the temporal collection.
   type :: xdmf_frame_t
      real(dp) :: time = 0.0_dp                  !< total time
+     integer :: n_points = 0                    !< Polyvertex: the frame's number of points
      character(len=:), allocatable :: name      !< grid name, e.g. frame_000003
      character(len=:), allocatable :: geometry  !< dataset of the node coordinates (n_nodes, 3)
      integer :: n_attributes = 0
@@ -49,11 +55,15 @@ module output_xdmf
   !> What every frame shares: the HDF5 file and the topology.
   type :: xdmf_mesh_t
      character(len=:), allocatable :: h5_file       !< HDF5 file name relative to the .xmf
-     character(len=:), allocatable :: topology      !< Quadrilateral or Hexahedron
+     character(len=:), allocatable :: topology      !< Quadrilateral, Hexahedron, Polyvertex or 3DCoRectMesh
      character(len=:), allocatable :: connectivity  !< dataset path (n_elems, nen), 0-based
+     character(len=:), allocatable :: collection    !< name of the temporal collection (default bulkflow)
      integer :: n_nodes = 0
      integer :: n_elems = 0
      integer :: nen = 0
+     integer :: grid_n(3) = 1                       !< 3DCoRectMesh: nodes in x, y, z
+     real(dp) :: origin(3) = 0.0_dp                 !< 3DCoRectMesh: first node (x, y, z)
+     real(dp) :: spacing(3) = 0.0_dp               !< 3DCoRectMesh: node distance in x, y, z
   end type xdmf_mesh_t
 
 contains
@@ -111,8 +121,8 @@ contains
     type(xdmf_frame_t), intent(in) :: frames(:)
     integer, intent(in) :: n_frames
     logical, intent(out) :: ok
-    integer :: unit, ios, f, a
-    character(len=:), allocatable :: tmp
+    integer :: unit, ios, f, a, n_nodes
+    character(len=:), allocatable :: tmp, collection
     character(len=32) :: tbuf
 
     tmp = path // '.tmp'
@@ -126,25 +136,40 @@ contains
     call put('<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>')
     call put('<Xdmf Version="2.0">')
     call put(' <Domain>')
-    call put('  <Grid Name="bulkflow" GridType="Collection" CollectionType="Temporal">')
+    collection = 'bulkflow'
+    if (allocated(mesh%collection)) collection = mesh%collection
+    call put('  <Grid Name="' // xml_escape(collection) // '" GridType="Collection" CollectionType="Temporal">')
     do f = 1, n_frames
        ! 17 significant digits: the time reads back as exactly the double we hold.
        write (tbuf, '(es25.16e3)') frames(f)%time
        call put('   <Grid Name="' // xml_escape(frames(f)%name) // '" GridType="Uniform">')
        call put('    <Time Value="' // trim(adjustl(tbuf)) // '"/>')
-       call put('    <Topology TopologyType="' // mesh%topology // '" NumberOfElements="' // &
-            int_to_str(mesh%n_elems) // '">')
-       call data_item(mesh%n_elems, mesh%nen, 'Int', 4, mesh%connectivity)
-       call put('    </Topology>')
-       call put('    <Geometry GeometryType="XYZ">')
-       call data_item(mesh%n_nodes, 3, 'Float', 8, frames(f)%geometry)
-       call put('    </Geometry>')
+       select case (mesh%topology)
+       case ('Polyvertex')
+          n_nodes = frames(f)%n_points
+          call put('    <Topology TopologyType="Polyvertex" NumberOfElements="' // int_to_str(n_nodes) // '"/>')
+          call geometry_xyz()
+       case ('3DCoRectMesh')
+          n_nodes = product(mesh%grid_n)
+          call put('    <Topology TopologyType="3DCoRectMesh" Dimensions="' // grid_dims() // '"/>')
+          call put('    <Geometry GeometryType="ORIGIN_DXDYDZ">')
+          call xml_triple(mesh%origin)
+          call xml_triple(mesh%spacing)
+          call put('    </Geometry>')
+       case default
+          n_nodes = mesh%n_nodes
+          call put('    <Topology TopologyType="' // mesh%topology // '" NumberOfElements="' // &
+               int_to_str(mesh%n_elems) // '">')
+          call data_item(mesh%n_elems, mesh%nen, 'Int', 4, mesh%connectivity)
+          call put('    </Topology>')
+          call geometry_xyz()
+       end select
        do a = 1, frames(f)%n_attributes
           associate (att => frames(f)%attributes(a))
             if (att%center == xdmf_center_node) then
                call put('    <Attribute Name="' // xml_escape(att%name) // '" AttributeType="' // &
                     xdmf_attribute_type(att%ncomp) // '" Center="Node">')
-               call data_item(mesh%n_nodes, att%ncomp, 'Float', 8, att%dataset)
+               call data_item(n_nodes, att%ncomp, 'Float', 8, att%dataset)
             else
                call put('    <Attribute Name="' // xml_escape(att%name) // '" AttributeType="' // &
                     xdmf_attribute_type(att%ncomp) // '" Center="Cell">')
@@ -175,7 +200,36 @@ contains
       ios = ios_line
     end subroutine put
 
-    !> A DataItem referring to an HDF5 dataset; one-component data is one-dimensional.
+    !> The frame's point coordinates (n_nodes, 3).
+    subroutine geometry_xyz()
+      call put('    <Geometry GeometryType="XYZ">')
+      call data_item(n_nodes, 3, 'Float', 8, frames(f)%geometry)
+      call put('    </Geometry>')
+    end subroutine geometry_xyz
+
+    !> "nz ny nx": a uniform grid's node counts in XDMF's (slowest first) order.
+    function grid_dims() result(dims)
+      character(len=:), allocatable :: dims
+
+      dims = int_to_str(mesh%grid_n(3)) // ' ' // int_to_str(mesh%grid_n(2)) // ' ' // &
+           int_to_str(mesh%grid_n(1))
+    end function grid_dims
+
+    !> Origin or spacing of a uniform grid as an inline DataItem, z first.
+    subroutine xml_triple(v)
+      real(dp), intent(in) :: v(3)
+      character(len=32) :: b(3)
+      integer :: i
+
+      do i = 1, 3
+         write (b(i), '(es25.16e3)') v(4 - i)
+      end do
+      call put('     <DataItem Dimensions="3" Format="XML">' // trim(adjustl(b(1))) // ' ' // &
+           trim(adjustl(b(2))) // ' ' // trim(adjustl(b(3))) // '</DataItem>')
+    end subroutine xml_triple
+
+    !> A DataItem referring to an HDF5 dataset; one-component data is one-dimensional; on a
+    !> uniform grid the rows are the grid's nodes "nz ny nx".
     subroutine data_item(n, ncomp, number_type, precision, dataset)
       integer, intent(in) :: n
       integer, intent(in) :: ncomp
@@ -184,11 +238,12 @@ contains
       character(len=*), intent(in) :: dataset
       character(len=:), allocatable :: dims
 
-      if (ncomp == 1) then
-         dims = int_to_str(n)
+      if (mesh%topology == '3DCoRectMesh') then
+         dims = grid_dims()
       else
-         dims = int_to_str(n) // ' ' // int_to_str(ncomp)
+         dims = int_to_str(n)
       end if
+      if (ncomp /= 1) dims = dims // ' ' // int_to_str(ncomp)
       call put('     <DataItem Dimensions="' // dims // '" NumberType="' // number_type // &
            '" Precision="' // int_to_str(precision) // '" Format="HDF">' // &
            xml_escape(mesh%h5_file) // ':' // xml_escape(dataset) // '</DataItem>')

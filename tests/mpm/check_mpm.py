@@ -251,7 +251,7 @@ def mpi(args):
     check(b["MASS_OUT"][-1] > 0 and b["MASS_IN"][-1] > 0, "outflow and inflow on 2 ranks")
     n_frame = int(h5py.File(str(args.workdir / "np2a") + ".h5", "r")["particles"][
         sorted(h5py.File(str(args.workdir / "np2a") + ".h5", "r")["particles"].keys())[-1]].attrs["count"][0])
-    check(n_frame == int(b["particles"][-1]), f"last frame holds all {n_frame} particles (gathered on rank 0)")
+    check(n_frame == int(b["particles"][-1]), f"last frame holds all {n_frame} particles (each rank writes its own rows)")
 
 
 def mpi_env():

@@ -4,13 +4,15 @@
     check_schedule.py --bulkflow EXE --workdir DIR ELEMENT.inp MPM.inp
 
 Runs the element scene and the MPM scene, which carry the same steps and *OUTPUT requests
-(several field and history requests, NUMBER INTERVAL, TIME INTERVAL, FREQUENCY, OP=NEW, fixed
-increments), and checks that
+(several field and history requests, NUMBER INTERVAL, TIME INTERVAL, FREQUENCY, TIME POINTS,
+OP=NEW, fixed increments), and checks that
   1. both write their field frames and history rows at the same (step, step time, increment);
   2. those are the times of the rule, computed here independently from the requests: every
      request has its own schedule (TIME INTERVAL=t: the first increment end at or past each
      multiple of t; NUMBER INTERVAL=n: t = period/n; FREQUENCY=n: every n-th increment), each
-     also at the step's start and end, and an output is written when any request is due.
+     also at the step's start and end, and an output is written when any request is due; a
+     TIME POINTS request (step 3) at its listed times only, each reached exactly by cutting the
+     increment before it (both solvers, every other increment unchanged).
 """
 import argparse
 import csv
@@ -21,32 +23,51 @@ from pathlib import Path
 import h5py
 
 # (period, fixed increment, field requests, history requests); a request: ('T', t) | ('N', n) | ('F', n)
+# | ('P', [listed step times]) (TIME POINTS=: the increment before a listed time is cut to end on it,
+# output at the listed times only)
 STEPS = [
     (0.1, 1.0e-3, [('N', 4), ('T', 0.03)], [('T', 0.04), ('F', 7)]),
     (0.06, 1.5e-3, [('F', 15)], [('N', 3)]),
+    (0.05, 2.0e-3, [('P', [0.013, 0.03, 0.0475]), ('N', 2)], [('P', [0.005, 0.013, 0.041])]),
 ]
 
 
 def expected(kind):
+    """(step, step time) of every output of `kind`, the increments simulated as the solvers take them."""
     out = []
-    for s, (period, dt, field, history) in enumerate(STEPS, start=1):
+    for s, (period, dt_fixed, field, history) in enumerate(STEPS, start=1):
         requests = field if kind == 'field' else history
-        n = round(period / dt)
+        points = sorted(t for k, v in field + history if k == 'P' for t in v)
+        tol = 1e-9 * period
         nxt = [(period / v if k == 'N' else v) if k in 'NT' else None for k, v in requests]
         interval = list(nxt)
-        out.append((s, 0))
-        for i in range(1, n + 1):
-            t = i * dt
-            due = i == n
+        if any(k != 'P' for k, _ in requests):
+            out.append((s, 0.0))
+        t, i = 0.0, 0
+        while t < period - 1e-12 * period:
+            dt = min(dt_fixed, period - t)
+            t_point = min([p for p in points if p > t + tol], default=float('inf'))
+            t_prev = t
+            if t_point - t <= dt:
+                dt, t = t_point - t, t_point
+            else:
+                t += dt
+            i += 1
+            boundary = t >= period * (1 - 1e-12)
+            due = False
             for j, (k, v) in enumerate(requests):
-                if k == 'F':
+                if k == 'P':
+                    due |= any(t_prev + tol < p <= t + tol for p in v)
+                elif boundary:
+                    due = True
+                elif k == 'F':
                     due |= i % v == 0
                 else:
                     due |= t >= nxt[j] - 1e-9 * max(period, dt)
             if due:
-                out.append((s, i))
+                out.append((s, t))
                 for j, (k, v) in enumerate(requests):
-                    if k != 'F':
+                    if k in 'NT':
                         while nxt[j] <= t + 1e-9 * period:
                             nxt[j] += interval[j]
     return out
@@ -91,7 +112,7 @@ def main():
     }
     failed = False
     for kind in ('field', 'history'):
-        want = [(s, i * STEPS[s - 1][1]) for s, i in expected(kind)]
+        want = expected(kind)
         for solver in ('element', 'mpm'):
             have = got[(kind, solver)]
             same = len(have) == len(want) and all(
@@ -102,6 +123,16 @@ def main():
             if not same:
                 print('      expected: ' + ' '.join(f'{s}:{t:.4f}' for s, t in want))
                 failed = True
+    # listed times are reached exactly: the output's step_time is the listed number bit for bit
+    for kind in ('field', 'history'):
+        listed = {(s, t) for s, (_, _, field, history) in enumerate(STEPS, start=1)
+                  for k, v in (field if kind == 'field' else history) if k == 'P' for t in v}
+        for solver in ('element', 'mpm'):
+            hit = listed & set(got[(kind, solver)])
+            same = hit == listed
+            print(f"{'ok  ' if same else 'FAIL'} {solver:7s} {kind:7s}: {len(hit)} of {len(listed)} TIME POINTS "
+                  f"outputs at exactly the listed step time")
+            failed |= not same
     sys.exit(1 if failed else 0)
 
 
