@@ -28,6 +28,12 @@ a = 30 degrees, mu = 0.3, gravity ramped in over 0.05 s). CASE says which deck i
               profile one LINE travelled so that its left is the slope's normal): verify + 1e-6.
   revolution  the plane written as *SURFACE, TYPE=REVOLUTION (axis along the slope normal, profile
               a LINE from r = 0 to r = 1 at z = 0, a disc): verify + 1e-6 against the analytic deck.
+  cae         the revolution deck in Abaqus/CAE's layout (bulkflow.scenes.cae_layout: the block in a
+              part, the wall an instance of an empty part), the wall's *SURFACE, TYPE=REVOLUTION
+              written as CAE writes it inside a part (no local-system line: the part's y axis is
+              the axis of revolution) and its instance rotated by 90 degrees about the down-slope
+              direction, which turns that y axis onto the slope normal: the same run as the flat
+              deck within 1e-6 (block displacement, wall force).
   cone        the block on the outside of a revolved cone (vertical axis 2 km up-slope of the block,
               meridian at 30 degrees, a START/LINE profile): it slides down a meridian with
               a = g (sin a - mu cos a) within 1 %, wall force within 1 % (the cone drops away from the
@@ -145,6 +151,45 @@ def revolution_deck(text: str) -> str:
     return text.replace(PLANE.search(text).group(0), surface)
 
 
+def cae_decks(text: str, workdir: Path) -> tuple[Path, Path]:
+    """(flat deck, CAE-layout deck with the in-part REVOLUTION surface in a rotated instance)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'scripts'))
+    from bulkflow.scenes.cae_layout import convert
+    s, n = slope_frame(text)
+    flat = revolution_deck(text).replace(
+        '*SURFACE INTERACTION', '*NODE, NSET=REFW\n100, 0., 0., -1.\n'
+        '*RIGID BODY, REF NODE=REFW, ANALYTICAL SURFACE=SLOPE\n*SURFACE INTERACTION', 1).replace(
+        '*DLOAD', '*BOUNDARY\nREFW, ENCASTRE\n*DLOAD', 1)
+    flat_path, cae_path = workdir / 'incline_flat.inp', workdir / 'incline_cae.inp'
+    flat_path.write_text(flat)
+    convert(flat_path, cae_path)
+    cae = cae_path.read_text()
+    m = re.search(r'\*Instance, name=SLOPE-1, part=SLOPE\n', cae)
+    cae = cae[:m.end()] + f'0., 0., 0.\n0., 0., 0., {fmt(s)}, 90.\n' + cae[m.end():]
+    system = f'0., 0., 0., {fmt(n)}\n'
+    assert system in cae
+    cae = cae.replace(system, '').replace('\nBOTTOM, SLOPE\n', '\nBOTTOM, SLOPE-1.SLOPE\n')
+    cae_path.write_text(cae)
+    return flat_path, cae_path
+
+
+def compare_cae(flat: Path, cae: Path) -> int:
+    h1 = np.genfromtxt(str(flat), delimiter=',', names=True)
+    h2 = np.genfromtxt(str(cae), delimiter=',', names=True)
+    failures = 0
+    for group, renamed in ((('U1_BLOCKN', 'U2_BLOCKN', 'U3_BLOCKN'), ('U1_FILL1BLOCKN', 'U2_FILL1BLOCKN', 'U3_FILL1BLOCKN')),
+                           (('WALLF1_SLOPE', 'WALLF2_SLOPE', 'WALLF3_SLOPE'),
+                            ('WALLF1_SLOPE1SLOPE', 'WALLF2_SLOPE1SLOPE', 'WALLF3_SLOPE1SLOPE'))):
+        ref = np.stack([h1[c] for c in group])
+        got = np.stack([h2[c] for c in renamed])
+        worst = float(np.max(np.abs(got - ref)) / np.max(np.abs(ref))) if ref.shape == got.shape else float('inf')
+        ok = worst <= 1e-6
+        print(f'  {"ok  " if ok else "FAIL"} CAE layout, in-part REVOLUTION in a rotated instance vs flat deck, '
+              f'{"/".join(group)}: largest difference {worst:.2e} of the largest magnitude (limit 1e-6)')
+        failures += not ok
+    return failures
+
+
 def cone_deck(text: str) -> str:
     """A cone about the vertical axis x = -2000, y = 0.05: its meridian in the plane y = 0.05 (the
     block's centre line) is the slope line z = -x tan a, i.e. z = -(r - 2000) tan a."""
@@ -200,13 +245,20 @@ def check_corner(history: Path, text: str) -> int:
 
 def main() -> int:
     p = argparse.ArgumentParser()
-    p.add_argument('case', choices=['r3d4', 'corner', 'moving', 'cylinder', 'revolution', 'cone'])
+    p.add_argument('case', choices=['r3d4', 'corner', 'moving', 'cylinder', 'revolution', 'cae', 'cone'])
     p.add_argument('scene', type=Path)
     p.add_argument('--bulkflow', required=True)
     p.add_argument('--workdir', type=Path, required=True)
     a = p.parse_args()
     a.workdir.mkdir(parents=True, exist_ok=True)
     text = a.scene.read_text()
+    if a.case == 'cae':
+        flat, cae = cae_decks(text, a.workdir)
+        run(a.bulkflow, flat, a.workdir / 'flat')
+        run(a.bulkflow, cae, a.workdir / 'cae')
+        failures = compare_cae(a.workdir / 'flat_history.csv', a.workdir / 'cae_history.csv')
+        print('OK' if not failures else f'FAIL ({failures})')
+        return 0 if not failures else 1
     deck = a.workdir / f'incline_{a.case}.inp'
     writers = {'r3d4': lambda t: r3d4_deck(t, False), 'corner': lambda t: r3d4_deck(t, True),
                'moving': moving_deck, 'cylinder': cylinder_deck, 'revolution': revolution_deck, 'cone': cone_deck}
