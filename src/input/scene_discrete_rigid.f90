@@ -285,13 +285,7 @@ contains
           return
        end if
     end do
-    do j = 1, blk%n_lines
-       call push(r%surface_label, upper(blk%lines(j)%field(1)))
-       call push(r%surface_name, name)
-    end do
-    call reparse_keyword_line(blk, '*SURFACE, TYPE=SEGMENTS, NAME=' // name, err)
-    call move_alloc(lines, blk%lines)
-    blk%n_lines = size(blk%lines)
+    call replace_surface(blk, r, name, 'SEGMENTS', lines, err)
   end subroutine surface_to_segments
 
   !> Segment indices in chain order (a(next) = b(current)); shorter than a if not one chain.
@@ -354,14 +348,27 @@ contains
        end do
        call set_line_text(lines(e), text)
     end do
+    call replace_surface(blk, r, name, 'FACETS', lines, err)
+  end subroutine surface_to_facets
+
+  !> The rigid *SURFACE `blk` becomes *SURFACE, TYPE=kind, NAME=name with data `lines`; its labels
+  !> are recorded for *RIGID BODY, ELSET=.
+  subroutine replace_surface(blk, r, name, kind, lines, err)
+    type(keyword_block_t), intent(inout) :: blk
+    type(rigid_elements_t), intent(inout) :: r
+    character(len=*), intent(in) :: name, kind
+    type(data_line_t), allocatable, intent(inout) :: lines(:)
+    type(error_t), intent(inout) :: err
+    integer :: j
+
     do j = 1, blk%n_lines
        call push(r%surface_label, upper(blk%lines(j)%field(1)))
        call push(r%surface_name, name)
     end do
-    call reparse_keyword_line(blk, '*SURFACE, TYPE=FACETS, NAME=' // name, err)
+    call reparse_keyword_line(blk, '*SURFACE, TYPE=' // kind // ', NAME=' // name, err)
     call move_alloc(lines, blk%lines)
     blk%n_lines = size(blk%lines)
-  end subroutine surface_to_facets
+  end subroutine replace_surface
 
   !> "x, y" (ncoord = 2) or "x, y, z" of node `id` from the *NODE blocks (coordinates written back
   !> exactly).
