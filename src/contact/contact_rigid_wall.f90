@@ -33,7 +33,8 @@
 module contact_rigid_wall
   use base_kinds, only: dp
   use model_surfaces, only: rigid_surface_t
-  use contact_geometry, only: surface_closest_point, surface_coordinate_scale
+  use contact_walls, only: surface_closest_point => wall_closest_point, &
+       surface_coordinate_scale => wall_coordinate_scale
   implicit none
   private
 

@@ -11,7 +11,7 @@ module scene_instance_map
   use base_kinds, only: dp
   use error_report, only: error_t, raise_error
   use keyword_reader, only: keyword_block_t, data_line_t, upper_case, is_integer_text, is_real_text, &
-    set_field
+    set_field, set_line_text
   use scene_util, only: itoa, field_name, field_blank
   implicit none
   private
@@ -126,6 +126,8 @@ contains
        case ('SURFACE')
           if (kind == 'E') then
              call rewrite_label_field(blk%lines(il), 1, 'E', owner, level, ip > 0, instances, n, asm, err)
+          else if (swept_surface(blk)) then
+             if (il == 1) call place_swept_system(blk, owner, level == level_part .or. ip > 0, err)
           else
              call rewrite_segment_line(blk%lines(il), owner, level == level_part .or. ip > 0, err)
           end if
@@ -397,6 +399,62 @@ contains
        call set_field(dl, i + 1, real_text(y(2)))
     end do
   end subroutine rewrite_segment_line
+
+  logical function swept_surface(blk)
+    type(keyword_block_t), intent(in) :: blk
+    integer :: ip
+
+    swept_surface = .false.
+    ip = param_position(blk, 'TYPE')
+    if (ip > 0) swept_surface = any(upper_case(blk%params(ip)%value) == ['CYLINDER  ', 'REVOLUTION'])
+  end function swept_surface
+
+  !> *SURFACE, TYPE=CYLINDER / REVOLUTION of a moved instance: the points a, b (and c) of its local
+  !> system placed (the START/LINE/CIRCL profile is in that system and stays). Lines omitted, as
+  !> Abaqus/CAE writes them inside a part, mean the part's axes (docs/keywords.md): written out first.
+  subroutine place_swept_system(blk, owner, placed, err)
+    type(keyword_block_t), intent(inout) :: blk
+    type(instance_t), intent(in) :: owner
+    logical, intent(in) :: placed
+    type(error_t), intent(inout) :: err
+    type(data_line_t), allocatable :: lines(:)
+    real(dp) :: x(3), y(3)
+    integer :: n_system, il, i, j
+
+    if (.not. (placed .and. owner%moved) .or. blk%n_lines < 1) return
+    n_system = 1
+    if (upper_case(blk%params(param_position(blk, 'TYPE'))%value) == 'CYLINDER') n_system = 2
+    if (.not. is_real_text(trim(adjustl(blk%lines(1)%field(1))))) then
+       allocate (lines(blk%n_lines + n_system))
+       lines(n_system + 1:) = blk%lines(1:blk%n_lines)
+       do il = 1, n_system
+          lines(il)%file => blk%lines(1)%file
+          lines(il)%line = blk%lines(1)%line
+       end do
+       if (n_system == 2) then
+          call set_line_text(lines(1), '0., 0., 0., 1., 0., 0.')
+          call set_line_text(lines(2), '0., 0., 1.')
+       else
+          call set_line_text(lines(1), '0., 0., 0., 0., 1., 0.')
+       end if
+       call move_alloc(lines, blk%lines)
+       blk%n_lines = size(blk%lines)
+    end if
+    do il = 1, min(n_system, blk%n_lines)
+       associate (dl => blk%lines(il))
+         do i = 1, dl%n_fields() - 2, 3
+            do j = 0, 2
+               call dl%real_field(i + j, x(j + 1), err)
+               if (err%raised) return
+            end do
+            y = place_point(owner, x)
+            do j = 0, 2
+               call set_field(dl, i + j, real_text(y(j + 1)))
+            end do
+         end do
+       end associate
+    end do
+  end subroutine place_swept_system
 
   !> Field i (an integer) + offset.
   subroutine offset_field(dl, i, offset, err)

@@ -6,6 +6,10 @@
 !>   CIRCL, x, y, xc, yc (end point and centre; the arc is the one under 180 degrees).
 !> * *SURFACE, TYPE=PLANE (bulkflow's, 3D analytic rigid surface): a point line x, y, z and
 !>   a normal line nx, ny, nz; the material lies on the side the normal points to.
+!> * *SURFACE, TYPE=CYLINDER / TYPE=REVOLUTION (3D analytic rigid surfaces, Abaqus's): the local
+!>   system's points a, b (and c) on one (two) lines, omitted inside a part, then the profile as
+!>   for SEGMENTS, in local (x, y) or (r, z) coordinates (read_swept).
+!> * *SURFACE, TYPE=FACETS (bulkflow's; what R3D3/R3D4 walls become): scene_facet_surface.
 !> * *RIGID BODY, REF NODE=..., ANALYTICAL SURFACE=...: the surface moves with that node.
 !>
 !> Element and rigid surfaces share one namespace, as in Abaqus.
@@ -16,7 +20,9 @@ module scene_surfaces
   use model, only: model_t
   use model_sets, only: find_set, name_length
   use model_surfaces, only: element_surface_t, rigid_surface_t, segment_t, segment_line, segment_arc, &
-       cpe4r_faces, c3d8r_faces
+       cpe4r_faces, c3d8r_faces, shape_cylinder, shape_revolution
+  use scene_facet_surface, only: read_facets
+  use contact_geometry, only: segment_closest_point
   use scene_layout, only: scene_layout_t
   use scene_sets, only: elem_targets
   use scene_util, only: itoa, rtoa, get_real, field_name, expect_fields, expect_lines, &
@@ -81,7 +87,7 @@ contains
          if (err%raised) return
          call blk%get_string('NAME', name, err)
          if (.not. err%raised) call blk%get_string('TYPE', stype, err, default='ELEMENT', &
-              choices=[character(len=8) :: 'ELEMENT', 'SEGMENTS', 'PLANE'])
+              choices=[character(len=10) :: 'ELEMENT', 'SEGMENTS', 'PLANE', 'CYLINDER', 'REVOLUTION', 'FACETS'])
          if (.not. err%raised) call check_name(blk, 'surface', name, name_length, err)
          if (err%raised) return
          if (find_element_surface(model, name) /= 0 .or. find_rigid_surface(model, name) /= 0) then
@@ -103,11 +109,16 @@ contains
             associate (rs => model%rigid_surfaces(model%n_rigid_surfaces))
               rs%name = name
               rs%ndim = model%mesh%ndim
-              if (stype == 'SEGMENTS') then
+              select case (stype)
+              case ('SEGMENTS')
                  call read_segments(blk, model%mesh%ndim, rs, err)
-              else
+              case ('CYLINDER', 'REVOLUTION')
+                 call read_swept(blk, stype, model%mesh%ndim, rs, err)
+              case ('FACETS')
+                 call read_facets(blk, model%mesh%ndim, rs, err)
+              case default
                  call read_plane(blk, model%mesh%ndim, rs, err)
-              end if
+              end select
             end associate
          end if
          if (err%raised) return
@@ -190,30 +201,36 @@ contains
     end associate
   end subroutine read_element_surface
 
-  !> START / LINE / CIRCL chain of a 2D analytic rigid surface.
-  subroutine read_segments(blk, ndim, rs, err)
+  !> START / LINE / CIRCL chain of a 2D analytic rigid surface; from line `first` on (present:
+  !> the profile of a CYLINDER or REVOLUTION surface, whatever ndim).
+  subroutine read_segments(blk, ndim, rs, err, first)
     type(keyword_block_t), intent(in) :: blk
     integer, intent(in) :: ndim
     type(rigid_surface_t), intent(inout) :: rs
     type(error_t), intent(inout) :: err
+    integer, intent(in), optional :: first
     character(len=:), allocatable :: kind
     real(dp) :: p(2), c(2), r0, r1, cross, dot
-    integer :: il, n
+    integer :: il, n, il0
 
-    if (ndim /= 2) then
-       call blk%fail('*SURFACE, TYPE=SEGMENTS in a 3D model; expected TYPE=PLANE for a 3D wall', err)
+    il0 = 1
+    if (present(first)) then
+       il0 = first
+    else if (ndim /= 2) then
+       call blk%fail('*SURFACE, TYPE=SEGMENTS in a 3D model; expected TYPE=PLANE, CYLINDER or REVOLUTION ' // &
+            'for a 3D wall', err)
        return
     end if
-    call expect_lines(blk, 2, huge(1), 'START, x, y then LINE, x, y or CIRCL, x, y, xc, yc lines', err)
+    call expect_lines(blk, il0 + 1, huge(1), 'START, x, y then LINE, x, y or CIRCL, x, y, xc, yc lines', err)
     if (err%raised) return
-    allocate (rs%segments(blk%n_lines - 1))
+    allocate (rs%segments(blk%n_lines - il0))
     n = 0
-    do il = 1, blk%n_lines
+    do il = il0, blk%n_lines
        associate (dl => blk%lines(il))
          kind = field_name(dl, 1)
-         if (il == 1 .neqv. kind == 'START') then
+         if (il == il0 .neqv. kind == 'START') then
             call raise_error(dl%file, dl%line, 'segment "' // dl%field(1) // '" here; expected ' // &
-                 trim(merge('START, x, y as the first line     ', 'LINE or CIRCL after the START line', il == 1)), err)
+                 trim(merge('START, x, y as the first line     ', 'LINE or CIRCL after the START line', il == il0)), err)
             return
          end if
          select case (kind)
@@ -275,6 +292,103 @@ contains
     end do
     rs%n_segments = n
   end subroutine read_segments
+
+  !> TYPE=CYLINDER: line 1 a, b (origin, a point on the local x axis), line 2 c (a point on the
+  !> generator, the local z axis), then the (x, y) profile. TYPE=REVOLUTION: line 1 a, b (a point on
+  !> the symmetry axis, the local z axis), then the (r, z) profile, r >= 0. Omitted system lines
+  !> (Abaqus/CAE inside a part): a = 0, b = (1, 0, 0), c = (0, 0, 1) for CYLINDER; a = 0, b = (0, 1, 0)
+  !> for REVOLUTION (CAE revolves about the part's y axis). The x axis of a CYLINDER is made normal to
+  !> the generator (b's component along it is dropped).
+  subroutine read_swept(blk, stype, ndim, rs, err)
+    type(keyword_block_t), intent(in) :: blk
+    character(len=*), intent(in) :: stype
+    integer, intent(in) :: ndim
+    type(rigid_surface_t), intent(inout) :: rs
+    type(error_t), intent(inout) :: err
+    real(dp) :: a(3), b(3), c(3), ez(3), ex(3), length
+    integer :: n_system, k
+
+    if (ndim /= 3) then
+       call blk%fail('*SURFACE, TYPE=' // stype // ' in a 2D model; expected TYPE=SEGMENTS for a 2D wall', err)
+       return
+    end if
+    call expect_lines(blk, 1, huge(1), 'the local system a, b' // trim(merge(' (line 2: c)', '            ', &
+         stype == 'CYLINDER')) // ' then START, LINE and CIRCL profile lines', err)
+    if (err%raised) return
+    n_system = merge(2, 1, stype == 'CYLINDER')
+    a = 0
+    b = [0.0_dp, 1.0_dp, 0.0_dp]
+    c = [0.0_dp, 0.0_dp, 1.0_dp]
+    if (stype == 'CYLINDER') b = [1.0_dp, 0.0_dp, 0.0_dp]
+    if (field_name(blk%lines(1), 1) == 'START') then
+       n_system = 0
+    else
+       call expect_fields(blk, blk%lines(1), 6, 6, 'x, y, z of a then of b', err)
+       if (.not. err%raised .and. n_system == 2) then
+          call expect_lines(blk, 2, huge(1), 'line 2: x, y, z of c, a point on the generator', err)
+          if (.not. err%raised) call expect_fields(blk, blk%lines(2), 3, 3, 'x, y, z of c, a point on the generator', err)
+       end if
+       do k = 1, 3
+          if (err%raised) return
+          call get_real(blk%lines(1), k, a(k), err)
+          if (.not. err%raised) call get_real(blk%lines(1), k + 3, b(k), err)
+          if (.not. err%raised .and. n_system == 2) call get_real(blk%lines(2), k, c(k), err)
+       end do
+       if (err%raised) return
+    end if
+    if (stype == 'CYLINDER') then
+       rs%shape = shape_cylinder
+       ez = c - a
+       ex = b - a
+    else
+       rs%shape = shape_revolution
+       ez = b - a
+       ex = [1.0_dp, 0.0_dp, 0.0_dp]
+       if (abs(ez(1)) > max(abs(ez(2)), abs(ez(3)))) ex = [0.0_dp, 1.0_dp, 0.0_dp]
+    end if
+    length = norm2(ez)
+    if (.not. (length > 0)) then
+       call raise_error(blk%lines(n_system)%file, blk%lines(n_system)%line, 'the ' // &
+            trim(merge('generator point c', 'axis point b     ', stype == 'CYLINDER')) // ' equals the origin a; ' // &
+            'expected a distinct point to give the ' // trim(merge('generator', 'axis     ', stype == 'CYLINDER')), err)
+       return
+    end if
+    ez = ez / length
+    ex = ex - dot_product(ex, ez) * ez
+    if (.not. (norm2(ex) > 1.0e-6_dp * norm2(b - a))) then
+       call raise_error(blk%lines(1)%file, blk%lines(1)%line, 'the local x axis (a to b) is along the ' // &
+            'generator (a to c); expected b off the generator line', err)
+       return
+    end if
+    rs%axes(:, 1) = ex / norm2(ex)
+    rs%axes(:, 3) = ez
+    rs%axes(:, 2) = [ez(2) * rs%axes(3, 1) - ez(3) * rs%axes(2, 1), ez(3) * rs%axes(1, 1) - ez(1) * rs%axes(3, 1), &
+         ez(1) * rs%axes(2, 1) - ez(2) * rs%axes(1, 1)]
+    call read_segments(blk, ndim, rs, err, first=n_system + 1)
+    rs%point = a   ! read_segments keeps the START point there
+    if (err%raised .or. stype /= 'REVOLUTION') return
+    do k = 1, rs%n_segments
+       if (min(rs%segments(k)%p0(1), rs%segments(k)%p1(1), arc_least_r(rs%segments(k))) < 0) then
+          call raise_error(blk%lines(n_system + 1 + k)%file, blk%lines(n_system + 1 + k)%line, 'profile point ' // &
+               'at r < 0; expected the (r, z) profile of a TYPE=REVOLUTION surface at r >= 0', err)
+          return
+       end if
+    end do
+  end subroutine read_swept
+
+  !> Smallest r of an arc's interior: its leftmost circle point if the arc passes through it (then
+  !> it is the arc's closest point to a point far to the left), else its end points; lines: huge.
+  pure real(dp) function arc_least_r(seg) result(r)
+    type(segment_t), intent(in) :: seg
+    real(dp) :: radius, cp(2), normal(2), dist
+    integer :: where
+
+    r = huge(1.0_dp)
+    if (seg%kind /= segment_arc) return
+    radius = norm2(seg%p0 - seg%centre)
+    call segment_closest_point(seg, seg%centre - [2 * radius, 0.0_dp], cp, normal, dist, where)
+    r = cp(1)
+  end function arc_least_r
 
   !> bulkflow's TYPE=PLANE: point line, normal line.
   subroutine read_plane(blk, ndim, rs, err)

@@ -32,10 +32,20 @@ module model_surfaces
      real(dp) :: p0(2) = 0, p1(2) = 0, centre(2) = 0
   end type segment_t
 
+  !> Shapes of a 3D rigid surface (rigid_surface_t%shape; 2D surfaces are segment chains).
+  integer, parameter, public :: shape_plane = 0        !< bulkflow's TYPE=PLANE: point, normal
+  integer, parameter, public :: shape_facets = 1       !< R3D3/R3D4 walls (TYPE=FACETS): triangles
+  integer, parameter, public :: shape_cylinder = 2     !< TYPE=CYLINDER: profile swept along axes(:, 3)
+  integer, parameter, public :: shape_revolution = 3   !< TYPE=REVOLUTION: (r, z) profile about axes(:, 3)
+
   !> An analytic rigid surface. 2D: a chain of segments. 3D: a plane through `point` with
   !> unit `normal` (bulkflow's *SURFACE, TYPE=PLANE). The material lies on the side the
   !> normal points to (2D: the left of the direction of travel along the segments, which
   !> is Abaqus's convention for TYPE=SEGMENTS). The surface translates with ref_node.
+  !> 3D shapes other than the plane (`shape`): facets (triangles facet_tris over the vertices
+  !> facet_points, material on the side of the right-hand normal), or the segment chain as a
+  !> profile in the local frame with origin `point` and orthonormal axes(:, 1:3) (CYLINDER: the
+  !> profile's x, y along axes 1, 2; REVOLUTION: r radial, z along axes(:, 3)).
   type, public :: rigid_surface_t
      character(len=name_length) :: name = ''
      integer :: ndim = 0
@@ -43,5 +53,10 @@ module model_surfaces
      type(segment_t), allocatable :: segments(:)
      real(dp) :: point(3) = 0, normal(3) = 0
      integer :: ref_node = 0              !< internal node index of the *RIGID BODY reference node (0: fixed)
+     integer :: shape = shape_plane
+     integer :: n_facets = 0
+     real(dp), allocatable :: facet_points(:, :)   !< (3, vertices)
+     integer, allocatable :: facet_tris(:, :)      !< (3, n_facets): vertex indices, right-hand order
+     real(dp) :: axes(3, 3) = 0
   end type rigid_surface_t
 end module model_surfaces
