@@ -167,12 +167,9 @@ contains
     class(element_technique_t), intent(in) :: this
     type(run_clock_t) :: c
 
-    c%step = this%solver%step
-    c%increment = this%solver%increment
-    c%step_increment = this%solver%step_increment
-    c%step_time = this%solver%step_time
-    c%total_time = this%solver%total_time
-    c%dt = this%solver%dt
+    associate (s => this%solver)
+      c = run_clock_t(s%step, s%increment, s%step_increment, s%step_time, s%total_time, s%dt)
+    end associate
   end function clock
 
   !> Nothing to add to the progress line.

@@ -171,12 +171,9 @@ contains
     class(mpm_technique_t), intent(in) :: this
     type(run_clock_t) :: c
 
-    c%step = this%st%step
-    c%increment = this%st%increment
-    c%step_increment = this%st%step_increment
-    c%step_time = this%st%step_time
-    c%total_time = this%st%total_time
-    c%dt = this%st%dt
+    associate (s => this%st)
+      c = run_clock_t(s%step, s%increment, s%step_increment, s%step_time, s%total_time, s%dt)
+    end associate
   end function clock
 
   !> The mass that left through the outflow on rank 0 (its particles; rank 0's share on several ranks).
