@@ -87,7 +87,7 @@ contains
           call one_increment(tech, m, istep, c)
           stop_now = opts%stop_after > 0 .and. c%increment >= opts%stop_after
           call increment_end(tech, m, opts, istep, c, field, history, stop_now)
-          call progress_line(progress, m, c, tech%progress_note())
+          call progress_line(progress, m, c, tech)
           if (stop_now) exit
           if (m%steps(istep)%stop%active) then
              if (mod(c%step_increment, stop_check_stride) == 0 .or. c%step_time >= period * (1 - 1.0e-12_dp)) then

@@ -10,7 +10,7 @@ module run_progress
   use base_kinds, only: dp
   use model, only: model_t
   use output_timer, only: clock_text
-  use run_technique, only: run_clock_t
+  use run_technique, only: run_clock_t, technique_t
   implicit none
   private
 
@@ -44,11 +44,12 @@ contains
     progress_seconds = real(now - p%start, dp) / real(p%rate, dp)
   end function progress_seconds
 
-  subroutine progress_line(p, m, c, note)
+  !> The technique's note is asked for only when the line is written (it may format numbers).
+  subroutine progress_line(p, m, c, tech)
     type(progress_t), intent(inout) :: p
     type(model_t), intent(in) :: m
     type(run_clock_t), intent(in) :: c
-    character(len=*), intent(in) :: note
+    class(technique_t), intent(in) :: tech
     integer(int64) :: now
     real(dp) :: elapsed, remaining, eta
     integer :: s
@@ -65,7 +66,7 @@ contains
     if (c%total_time > p%sim_start) eta = elapsed / (c%total_time - p%sim_start) * remaining
     write (output_unit, '(a,i0,a,i0,1x,a,a,es10.3,a,es10.3,a,es10.3,a,i0,a,es9.2,a,a,a)') '  step ', s, '/', &
          m%n_steps, trim(m%steps(s)%name), '  t ', c%step_time, '/', m%steps(s)%period, '  total ', &
-         c%total_time, '  inc ', c%increment, '  dt ', c%dt, '  ETA ', clock_text(eta), note
+         c%total_time, '  inc ', c%increment, '  dt ', c%dt, '  ETA ', clock_text(eta), tech%progress_note()
     flush (output_unit)
   end subroutine progress_line
 
