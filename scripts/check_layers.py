@@ -40,6 +40,9 @@ LAYERS: list[tuple[str, list[str], str]] = [
     ('techniques', ['src/driver', 'src/mpm', 'src/matpoint'],
      'the element solver, the material point method and the material-point driver: '
      'peers, none uses another'),
+    ('run', ['src/run'], 'the run skeleton: one step loop (output schedule, stop conditions, '
+                         'checkpoints, progress, end report) over the abstract technique, and the '
+                         'element solver and the MPM as its two extensions'),
     ('app', ['src/app'], 'main programs'),
 ]
 

@@ -20,8 +20,10 @@ program bulkflow
   use error_report, only: error_t, set_final_stop
   use model, only: model_t
   use scene_reader, only: read_scene
-  use driver_run, only: run_options_t, run_scene
-  use mpm_run, only: mpm_run_scene
+  use run_technique, only: run_options_t, technique_t
+  use run_loop, only: run_scene
+  use run_element, only: element_technique_t
+  use run_mpm, only: mpm_technique_t
   use abaqus_host, only: host_set_exit_handler, host_set_job
   use user_library, only: user_library_prepare, user_library_open
   use material_entry, only: use_linked_entries
@@ -31,6 +33,7 @@ program bulkflow
   type(model_t) :: m
   type(error_t) :: err
   type(run_options_t) :: opts
+  class(technique_t), allocatable :: technique
   character(len=:), allocatable :: scene, user_file
   character(len=1024), allocatable :: user_includes(:)
   logical :: check_only, user_linked
@@ -70,10 +73,15 @@ program bulkflow
         write (output_unit, '(a,i0,a,i0,a,i0,a)') 'bulkflow: ' // scene // ': OK (', &
              m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, ' elements, ', m%n_steps, ' steps)'
      end if
-  else if (m%mpm%active) then
-     call run_mpm(m, opts)
   else
-     call run_scene(m, MPI_COMM_WORLD, opts)
+     ! One step loop for every scene (src/run): the technique is the scene's — the material
+     ! point method for a scene with *MPM GRID, the element solver otherwise.
+     if (m%mpm%active) then
+        allocate (mpm_technique_t :: technique)
+     else
+        allocate (element_technique_t :: technique)
+     end if
+     call run_scene(technique, m, MPI_COMM_WORLD, opts)
   end if
   call MPI_Finalize()
 
@@ -202,14 +210,4 @@ contains
     type(error_t), intent(in) :: err
     call stop_agreed_error(MPI_COMM_WORLD, err)
   end subroutine input_error_exit
-
-  !> A material-point scene (particle decomposition over the ranks, src/mpm/mpm_run.f90), with
-  !> checkpoints at *RESTART, WRITE and --stop-after, --restart from the last one
-  !> (src/mpm/mpm_checkpoint.f90).
-  subroutine run_mpm(m, opts)
-    type(model_t), intent(in) :: m
-    type(run_options_t), intent(in) :: opts
-
-    call mpm_run_scene(m, opts%output_base, opts%progress, opts%stop_after, MPI_COMM_WORLD, opts%restart)
-  end subroutine run_mpm
 end program bulkflow

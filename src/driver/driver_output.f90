@@ -1,8 +1,8 @@
 !> Everything the run writes while it goes: field frames (HDF5 + XDMF) at the requested
 !> intervals, history rows (energies, wall forces, node-set values) in CSV, the energy-balance
-!> check, and the progress line with an ETA.
+!> check (the progress line is the run skeleton's: src/run/run_progress.f90).
 module driver_output
-  use, intrinsic :: iso_fortran_env, only: int64, output_unit, error_unit
+  use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use mpi_f08, only: MPI_Comm
   use base_kinds, only: dp
   use model, only: model_t
@@ -14,8 +14,6 @@ module driver_output
        field_writer_coordinates, field_writer_node_field, field_writer_element_field, field_writer_close, &
        field_writer_frame_count
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
-  use output_timer, only: clock_text
-  use output_schedule, only: output_schedule_t, field_schedule, history_schedule, schedule_resume
   use fem_corotation, only: stored_to_global
   use driver_stop_condition, only: count_stop_columns, add_stop_columns, stop_column_values
   implicit none
@@ -28,20 +26,14 @@ module driver_output
      logical :: fields_open = .false.
      integer :: n_history_columns = 0
      character(len=32), allocatable :: columns(:)   !< history column names
-     !> the running step's frame and row schedules (output_schedule: the rule MPM shares)
-     type(output_schedule_t) :: field_schedule, history_schedule
      real(dp) :: energy_reference = 0               !< ETOTAL at the start (subtracted)
      !> Energy-balance check (write_history): energies below energy_floor are not significant;
      !> energy_peak is the largest max(ALLKE, ALLIE, |ALLWK|) seen so far.
      real(dp) :: energy_floor = 0, energy_peak = 0
      logical :: balance_warned = .false.
-     integer(int64) :: wall_start = 0, wall_last_progress = 0, clock_rate = 1
-     real(dp) :: sim_start = 0
-     logical :: progress = .true.
   end type run_output_t
 
-  public :: open_run_output, close_run_output, step_output_start, write_frame, &
-       write_history, energy_values, progress_line, sum_over_ranks, next_time_point
+  public :: open_run_output, close_run_output, write_frame, write_history, energy_values, sum_over_ranks
 
 contains
 
@@ -113,9 +105,6 @@ contains
     else
        call history_open(out%history, base // '_history.csv', columns(1:n), solver%part%comm)
     end if
-    call system_clock(out%wall_start, out%clock_rate)
-    out%wall_last_progress = out%wall_start
-    out%sim_start = solver%total_time
   end subroutine open_run_output
 
   !> Columns of one history request, without duplicates of earlier steps' identical requests.
@@ -142,63 +131,6 @@ contains
     out%fields_open = .false.
     call history_close(out%history)
   end subroutine close_run_output
-
-  pure logical function has_points(points)
-    real(dp), allocatable, intent(in) :: points(:)
-
-    has_points = .false.
-    if (allocated(points)) has_points = size(points) > 0
-  end function has_points
-
-  !> The first listed time (TIME POINTS=) of any field or history request of the step after
-  !> t + tol; huge when there is none.
-  real(dp) function next_time_point(m, istep, t, tol)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: istep
-    real(dp), intent(in) :: t, tol
-    integer :: j
-
-    next_time_point = huge(1.0_dp)
-    if (allocated(m%steps(istep)%field_outputs)) then
-       do j = 1, size(m%steps(istep)%field_outputs)
-          call take(m%steps(istep)%field_outputs(j)%time_points)
-       end do
-    end if
-    if (allocated(m%steps(istep)%history_outputs)) then
-       do j = 1, size(m%steps(istep)%history_outputs)
-          call take(m%steps(istep)%history_outputs(j)%time_points)
-       end do
-    end if
-  contains
-    subroutine take(points)
-      real(dp), allocatable, intent(in) :: points(:)
-      integer :: k
-
-      if (.not. has_points(points)) return
-      do k = 1, size(points)
-         if (points(k) > t + tol) then
-            next_time_point = min(next_time_point, points(k))
-            return
-         end if
-      end do
-    end subroutine take
-  end function next_time_point
-
-  !> At the start of a step (or where a restart continues it, at step time `resume_time`): the
-  !> step's frame and row schedules.
-  subroutine step_output_start(m, istep, out, resume_time)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: istep
-    type(run_output_t), intent(inout) :: out
-    real(dp), intent(in), optional :: resume_time
-
-    call field_schedule(m%steps(istep), out%field_schedule)
-    call history_schedule(m%steps(istep), out%history_schedule)
-    if (present(resume_time)) then
-       call schedule_resume(out%field_schedule, resume_time)
-       call schedule_resume(out%history_schedule, resume_time)
-    end if
-  end subroutine step_output_start
 
   !> One field frame with the variables the step asks for.
   subroutine write_frame(m, solver, out, istep)
@@ -508,33 +440,4 @@ contains
     values = reshape(flat, shape(values))
   end subroutine sum_over_ranks
 
-  !> "step 2/3 SLIDE  t 0.4000/1.0000  inc 12345  dt 1.2e-05  ETA 0:00:42", at most every 2 s
-  !> of wall time, and always when forced (end of a step).
-  subroutine progress_line(m, solver, out, istep, force)
-    type(model_t), intent(in) :: m
-    type(solver_t), intent(in) :: solver
-    type(run_output_t), intent(inout) :: out
-    integer, intent(in) :: istep
-    logical, intent(in) :: force
-    integer(int64) :: now
-    real(dp) :: elapsed, done, remaining, eta
-    integer :: i
-
-    if (.not. out%progress .or. solver%part%rank /= 0) return
-    call system_clock(now)
-    if (.not. force .and. real(now - out%wall_last_progress, dp) < 2.0_dp * out%clock_rate) return
-    out%wall_last_progress = now
-    elapsed = real(now - out%wall_start, dp) / out%clock_rate
-    done = solver%total_time - out%sim_start
-    remaining = m%steps(istep)%period - solver%step_time
-    do i = istep + 1, m%n_steps
-       remaining = remaining + m%steps(i)%period
-    end do
-    eta = 0
-    if (done > 0) eta = elapsed / done * remaining
-    write (output_unit, '(a,i0,a,i0,1x,a,a,es10.3,a,es10.3,a,i0,a,es9.2,a,a)') 'step ', istep, '/', m%n_steps, &
-         trim(m%steps(istep)%name), '  t ', solver%step_time, '/', m%steps(istep)%period, '  inc ', &
-         solver%increment, '  dt ', solver%dt, '  ETA ', clock_text(eta)
-    flush (output_unit)
-  end subroutine progress_line
 end module driver_output

@@ -1,49 +1,36 @@
-!> The explicit time integration of a whole scene: steps in sequence, each increment as the named
-!> phases of the central-difference scheme (docs/solver_interfaces.md §0), with output,
-!> progress, checkpoints and restart. The increment reads like a table of contents; each phase
+!> The element solver's increment: each increment as the named phases of the central-difference
+!> scheme (docs/solver_interfaces.md §0), the start of a step (its loads, the initial forces and
+!> accelerations), and the increment the solver proposes. The step loop, outputs, progress and
+!> checkpoints are the run skeleton's (src/run: run_loop drives element_technique_t of
+!> run_element, which calls these). The increment reads like a table of contents; each phase
 !> lives in its own module.
 module driver_run
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use mpi_f08, only: MPI_Comm
   use base_kinds, only: dp
-  use error_report, only: error_t, raise_error
   use model, only: model_t
   use model_mesh, only: element_cpe4r, element_cax4r
-  use parallel_partition, only: partition_t, partition_model
+  use parallel_partition, only: partition_t
   use parallel_assembly, only: global_min, global_sum
   use driver_solver, only: solver_t
-  use driver_effects, only: effects_t, effect_gravity, effect_pressure, effect_rigid_walls, effect_boundary, &
-       effect_assembly, effect_output, effect_checkpoint, effect_user_field
-  use driver_setup, only: setup_solver, initial_internal_forces
-  use driver_elements, only: element_workspace_t, element_workspace_init, element_phase
+  use driver_effects, only: effects_t, effect_gravity, effect_pressure, effect_rigid_walls, effect_boundary
+  use driver_setup, only: initial_internal_forces
+  use driver_elements, only: element_workspace_t, element_phase
   use driver_loads, only: step_loads_t, prepare_step, apply_prescribed_velocities, &
        apply_rigid_body_velocities, gravity_forces, apply_contact, gravity_varies_in_step
-  use driver_output, only: run_output_t, open_run_output, close_run_output, step_output_start, &
-       write_frame, write_history, energy_values, progress_line, sum_over_ranks, next_time_point
-  use driver_checkpoint, only: save_checkpoint, load_checkpoint
+  use driver_output, only: run_output_t, energy_values
   use driver_mass_scaling, only: apply_step_mass_scaling
   use driver_pressure, only: step_pressures_t, prepare_pressures, add_pressure_forces
   use driver_finite, only: energies_finite, stop_non_finite, non_finite_flag
-  use driver_stop_condition, only: stop_step_start, check_stop_condition, report_stop_condition
+  use driver_stop_condition, only: stop_step_start
   use fem_cpe4r, only: cpe4r_char_length
   use fem_cax4r, only: cax4r_char_length
   use fem_c3d8r, only: c3d8r_char_length
   use fem_stable_dt, only: element_stable_dt
-  use output_timer, only: timer_report
-  use output_schedule, only: schedule_due, schedule_advance
-  use output_collective, only: stop_agreed_error
   implicit none
   private
 
   !> Nodes per chunk of finish_nodes_2d: its arrays, 1024 nodes × 10 values, stay in L2.
   integer, parameter :: node_chunk = 1024
-
-  type, public :: run_options_t
-     character(len=:), allocatable :: output_base     !< path of the outputs without extension
-     logical :: restart = .false.                     !< continue from the checkpoint
-     integer :: stop_after = 0                        !< > 0: stop after this increment (tests)
-     logical :: progress = .true.
-  end type run_options_t
 
   !> Margin on the element estimate L_e/c_d. Our L_e (area/longest edge, volume/largest face)
   !> equals the exact limit for regular meshes of many elements, but measured critical
@@ -52,146 +39,75 @@ module driver_run
   !> Lone free elements are stiffer still (0.84 / 0.73): scenes with them need SCALE FACTOR.
   real(dp), parameter :: stable_dt_safety = 0.9_dp
 
-  !> A *STOP CONDITION is evaluated every this many increments of its step (and at the step
-  !> end): its exact global sum costs about a tenth of an increment of a small 2D model.
-  integer, parameter :: stop_check_stride = 10
-
-  public :: run_scene
+  public :: start_step, proposed_increment, one_increment, strain_energy_scale, print_header, print_summary
 
 contains
 
-  subroutine run_scene(m, comm, opts)
+  !> The start of step istep: its loads and pressures on this rank's nodes; unless resumed (a
+  !> restart continuing the step), the clock at the step's start, the step's mass scaling and
+  !> stop condition, and the forces and accelerations of its first increment (in step 1 the
+  !> initial internal forces, the first stable increment and the energy reference too).
+  subroutine start_step(m, istep, resumed, solver, effects, loads, pressures, out)
     type(model_t), intent(in) :: m
-    type(MPI_Comm), intent(in) :: comm
-    type(run_options_t), intent(in) :: opts
-    type(partition_t) :: part
-    type(solver_t) :: solver
-    type(effects_t) :: effects
-    type(element_workspace_t) :: ew
-    type(step_loads_t) :: loads
-    type(step_pressures_t) :: pressures
-    type(run_output_t) :: out
-    integer :: istep, first_step, max_state, max_field, i, frames, rows
-    real(dp) :: dt_min, energies(6)
-    logical :: resumed, stop_now, condition_met
-    real(dp) :: period
-    type(error_t) :: err
+    integer, intent(in) :: istep
+    logical, intent(in) :: resumed
+    type(solver_t), intent(inout) :: solver
+    type(effects_t), intent(in) :: effects
+    type(step_loads_t), intent(inout) :: loads
+    type(step_pressures_t), intent(inout) :: pressures
+    type(run_output_t), intent(inout) :: out
+    real(dp) :: energies(6)
 
-    call partition_model(m, comm, part)
-    call effects%decide(m)
-    call setup_solver(m, part, solver, effects%active(effect_user_field))
-    max_state = 1
-    max_field = 1
-    do i = 1, m%n_materials
-       max_state = max(max_state, m%materials(i)%nstatev)
-       max_field = max(max_field, m%materials(i)%nfieldv)
-    end do
-    call element_workspace_init(ew, solver%part, solver%ndim, solver%nen, solver%ncomp, solver%nshr, max_state, max_field)
-
-    first_step = 1
-    resumed = .false.
-    if (opts%restart) then
-       call load_checkpoint(m, opts%output_base, solver, first_step, frames, rows, err)
-       if (err%raised) call stop_agreed_error(part%comm, err)
-       resumed = .true.
-       call open_run_output(m, solver, out, opts%output_base, frames, rows, solver%total_time)
-       call step_output_start(m, first_step, out, solver%step_time)
-       out%energy_reference = solver%restart_energy_reference
-       out%energy_peak = solver%restart_energy_peak
+    call prepare_step(m, istep, solver, loads)
+    call prepare_pressures(m, istep, solver, pressures)
+    if (resumed) return
+    solver%step = istep
+    solver%step_time = 0
+    solver%step_start = solver%total_time
+    solver%step_increment = 0
+    call stop_step_start(solver)
+    call apply_step_mass_scaling(m, istep, solver, solver%dt_stable)
+    if (istep == 1) then
+       call initial_internal_forces(m, solver)
+       call gravity_forces(m, loads, solver, 0.0_dp, solver%f_ext)
+       if (effects%active(effect_pressure)) &
+            call add_pressure_forces(m, pressures, solver, 0.0_dp, 0.0_dp, solver%f_ext)
+       call update_accelerations(solver)
+       solver%dt_stable = initial_stable_dt(m, solver, m%steps(1)%bulk_linear)
+       call energy_values(solver, energies)
+       out%energy_reference = energies(1) + energies(2) + energies(3) + energies(4) - energies(5)
     else
-       call open_run_output(m, solver, out, opts%output_base)
-    end if
-    out%progress = opts%progress
-    out%energy_floor = 1.0e-12_dp * strain_energy_scale(solver)
-    if (part%rank == 0) call print_header(m, part, solver, effects, opts)
-
-    stop_now = .false.
-    condition_met = .false.
-    do istep = first_step, m%n_steps
-       call prepare_step(m, istep, solver, loads)
-       call prepare_pressures(m, istep, solver, pressures)
-       period = m%steps(istep)%period
-       if (.not. resumed) then
-          solver%step = istep
-          solver%step_time = 0
-          solver%step_start = solver%total_time
-          solver%step_increment = 0
-          call step_output_start(m, istep, out)
-          call stop_step_start(solver)
-          call apply_step_mass_scaling(m, istep, solver, solver%dt_stable)
-          if (istep == 1) then
-             call initial_internal_forces(m, solver)
-             call gravity_forces(m, loads, solver, 0.0_dp, solver%f_ext)
-             if (effects%active(effect_pressure)) &
-                  call add_pressure_forces(m, pressures, solver, 0.0_dp, 0.0_dp, solver%f_ext)
-             call update_accelerations(solver)
-             solver%dt_stable = initial_stable_dt(m, solver, m%steps(1)%bulk_linear)
-             call energy_values(solver, energies)
-             out%energy_reference = energies(1) + energies(2) + energies(3) + energies(4) - energies(5)
-          else
-             ! The step's loads and constraints from its first increment on: gravity at step time
-             ! 0 of this step, and accelerations/reactions with this step's prescribed dofs (a dof
-             ! released now must accelerate in the first increment, not keep a = 0).
-             if (effects%active(effect_gravity)) call gravity_forces(m, loads, solver, 0.0_dp, solver%f_ext)
-             if (effects%active(effect_pressure)) then
-                if (.not. effects%active(effect_gravity)) solver%f_ext = 0
-                call add_pressure_forces(m, pressures, solver, 0.0_dp, 0.0_dp, solver%f_ext)
-             end if
-             call update_accelerations(solver)
-          end if
-          call write_outputs(m, solver, out, effects, istep)
+       ! The step's loads and constraints from its first increment on: gravity at step time
+       ! 0 of this step, and accelerations/reactions with this step's prescribed dofs (a dof
+       ! released now must accelerate in the first increment, not keep a = 0).
+       if (effects%active(effect_gravity)) call gravity_forces(m, loads, solver, 0.0_dp, solver%f_ext)
+       if (effects%active(effect_pressure)) then
+          if (.not. effects%active(effect_gravity)) solver%f_ext = 0
+          call add_pressure_forces(m, pressures, solver, 0.0_dp, 0.0_dp, solver%f_ext)
        end if
-       resumed = .false.
-
-       do while (solver%step_time < period * (1 - 1.0e-12_dp))
-          call one_increment(m, solver, effects, ew, loads, pressures, istep, dt_min)
-          call write_outputs(m, solver, out, effects, istep)
-          call progress_line(m, solver, out, istep, .false.)
-          if (effects%active(effect_checkpoint)) then
-             if (checkpoint_due(m, solver, istep) .or. solver%increment == opts%stop_after) then
-                call effects%start(effect_checkpoint)
-                call save_checkpoint(m, opts%output_base, solver, out)
-                call effects%stop(effect_checkpoint)
-             end if
-          else if (solver%increment == opts%stop_after) then
-             ! --stop-after always leaves a checkpoint to continue from, *RESTART or not (before,
-             ! a scene without *RESTART stopped, said "continue with --restart" and had none).
-             call save_checkpoint(m, opts%output_base, solver, out)
-          end if
-          if (solver%increment == opts%stop_after) then
-             stop_now = .true.
-             exit
-          end if
-          if (m%steps(istep)%stop%active) then
-             if (mod(solver%step_increment, stop_check_stride) == 0 .or. &
-                  solver%step_time >= period * (1 - 1.0e-12_dp)) then
-                if (check_stop_condition(m, istep, solver)) then
-                   ! The last row and frame at the moment of the decision.
-                   call write_history(m, solver, out, istep)
-                   call write_frame(m, solver, out, istep)
-                   condition_met = .true.
-                   exit
-                end if
-             end if
-          end if
-       end do
-       call progress_line(m, solver, out, istep, .true.)
-       if (.not. stop_now) call report_stop_condition(m, istep, solver)
-       if (stop_now .or. condition_met) exit
-    end do
-
-    call close_run_output(out)
-    if (m%n_rigid_surfaces > 0) call sum_over_ranks(solver, solver%wall_force)
-    if (part%rank == 0) then
-       if (stop_now) write (output_unit, '(a,i0,a)') 'bulkflow: stopped after increment ', solver%increment, &
-            ' as asked (--stop-after); continue with --restart'
-       call print_summary(m, solver)
+       call update_accelerations(solver)
     end if
-    call timer_report(effects%timers, output_unit, comm)
-  end subroutine run_scene
+  end subroutine start_step
 
-  !> One central-difference increment, t_n → t_{n+1}.
-  subroutine one_increment(m, solver, effects, ew, loads, pressures, istep, dt_min)
+  !> The increment the solver takes next, before the step's end and TIME POINTS cut it: the
+  !> stable one (scaled, with the safety margin) or the step's fixed one.
+  real(dp) function proposed_increment(m, istep, solver) result(dt)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: istep
+    type(solver_t), intent(in) :: solver
+
+    associate (s => m%steps(istep))
+      if (s%dt_fixed > 0) then
+         dt = s%dt_fixed
+      else
+         dt = s%dt_scale * stable_dt_safety * solver%dt_stable
+      end if
+    end associate
+  end function proposed_increment
+
+  !> One central-difference increment, t_n → t_{n+1}: Δt = dt, ending at step time t_new (the
+  !> run skeleton's cut of proposed_increment: src/run/run_loop.f90).
+  subroutine one_increment(m, solver, effects, ew, loads, pressures, istep, dt, t_new, dt_min)
     type(model_t), intent(in) :: m
     type(solver_t), intent(inout) :: solver
     type(effects_t), intent(inout) :: effects
@@ -199,26 +115,13 @@ contains
     type(step_loads_t), intent(in) :: loads
     type(step_pressures_t), intent(in) :: pressures
     integer, intent(in) :: istep
+    real(dp), intent(in) :: dt, t_new
     real(dp), intent(out) :: dt_min
-    real(dp) :: dt, dt_avg, t_mid, t_new, t_point, work, free_sum
+    real(dp) :: dt_avg, t_mid, work, free_sum
     integer :: i, dt_elem
     logical :: gravity_varies
 
     associate (s => m%steps(istep))
-      ! Time increment: the stable one (scaled), or the user's; never past the end of the step.
-      if (s%dt_fixed > 0) then
-         dt = s%dt_fixed
-      else
-         dt = s%dt_scale * stable_dt_safety * solver%dt_stable
-      end if
-      dt = min(dt, s%period - solver%step_time)
-      ! TIME POINTS= output: the increment is cut to end exactly on the next listed time.
-      t_point = next_time_point(m, istep, solver%step_time, 1.0e-9_dp * s%period)
-      t_new = solver%step_time + dt
-      if (t_point - solver%step_time <= dt) then
-         dt = t_point - solver%step_time
-         t_new = t_point
-      end if
       solver%dt = dt
       t_mid = solver%step_time + 0.5_dp * dt
 
@@ -541,41 +444,6 @@ contains
     reaction = merge(f_int - f_ext, 0.0_dp, fixed)
   end subroutine dof_acceleration
 
-  subroutine write_outputs(m, solver, out, effects, istep)
-    type(model_t), intent(in) :: m
-    type(solver_t), intent(inout) :: solver
-    type(run_output_t), intent(inout) :: out
-    type(effects_t), intent(inout) :: effects
-    integer, intent(in) :: istep
-    call effects%start(effect_output)
-    if (schedule_due(out%field_schedule, solver%step_time, solver%step_increment, solver%dt)) then
-       call write_frame(m, solver, out, istep)
-       call schedule_advance(out%field_schedule, solver%step_time)
-    end if
-    if (schedule_due(out%history_schedule, solver%step_time, solver%step_increment, solver%dt)) then
-       call write_history(m, solver, out, istep)
-       call schedule_advance(out%history_schedule, solver%step_time)
-    end if
-    call effects%stop(effect_output)
-  end subroutine write_outputs
-
-  logical function checkpoint_due(m, solver, istep)
-    type(model_t), intent(in) :: m
-    type(solver_t), intent(in) :: solver
-    integer, intent(in) :: istep
-    real(dp) :: interval, before
-
-    checkpoint_due = .false.
-    if (.not. m%steps(istep)%restart_write) return
-    interval = m%steps(istep)%restart_interval
-    if (interval <= 0) then
-       checkpoint_due = solver%step_time >= m%steps(istep)%period * (1 - 1.0e-12_dp)
-       return
-    end if
-    before = solver%step_time - solver%dt
-    checkpoint_due = floor(solver%step_time / interval + 1.0e-9_dp) > floor(before / interval + 1.0e-9_dp)
-  end function checkpoint_due
-
   !> Stable increment of the undeformed mesh: L_e / c_d with the linear bulk-viscosity damping.
   real(dp) function initial_stable_dt(m, solver, b1)
     type(model_t), intent(in) :: m
@@ -614,32 +482,30 @@ contains
     call global_min(solver%part, initial_stable_dt)
   end function initial_stable_dt
 
-  subroutine print_header(m, part, solver, effects, opts)
+  !> The run's header (rank 0): heading, model, active effects, output files.
+  subroutine print_header(m, part, effects, output_base)
     type(model_t), intent(in) :: m
     type(partition_t), intent(in) :: part
-    type(solver_t), intent(in) :: solver
     type(effects_t), intent(in) :: effects
-    type(run_options_t), intent(in) :: opts
+    character(len=*), intent(in) :: output_base
 
     write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
     write (output_unit, '(a,i0,a,i0,a,i0,a,i0,a)') '  model     ', m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, &
          ' elements, ', m%n_steps, ' step(s), ', part%nranks, ' rank(s)'
     write (output_unit, '(a)') '  effects   ' // effects%active_list()
-    write (output_unit, '(a)') '  output    ' // opts%output_base // '.h5/.xmf, ' // opts%output_base // &
+    write (output_unit, '(a)') '  output    ' // output_base // '.h5/.xmf, ' // output_base // &
          '_history.csv'
-    if (opts%restart) write (output_unit, '(a,i0,a,es12.5)') '  restart   from increment ', solver%increment, &
-         ' at t = ', solver%total_time
     flush (output_unit)
   end subroutine print_header
 
+  !> The element solver's lines of the end report (rank 0): final energies, wall forces (summed
+  !> over the ranks before).
   subroutine print_summary(m, solver)
     type(model_t), intent(in) :: m
     type(solver_t), intent(in) :: solver
     integer :: i
     real(dp) :: wall(solver%ndim, max(1, m%n_rigid_surfaces))
 
-    write (output_unit, '(a,i0,a,es12.5)') 'bulkflow: done, ', solver%increment, ' increments, t = ', &
-         solver%total_time
     associate (e => solver%energies)
       write (output_unit, '(a,6es12.4)') '  energies  ALLKE ALLIE ALLVD ALLFD ALLWK ALLAE:', e%kinetic, &
            e%internal, e%viscous, e%friction, e%external, e%artificial

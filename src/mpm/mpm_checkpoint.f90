@@ -65,7 +65,7 @@ module mpm_checkpoint
      integer :: rows = 0                              !< history rows written
   end type mpm_saved_t
 
-  public :: mpm_checkpoint_due, mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
+  public :: mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
 
   integer, parameter :: n_scalars = 18
   integer, parameter :: n_counters = 7
@@ -75,25 +75,6 @@ module mpm_checkpoint
        'rot', 'stress', 'stress_global', 'state', 'field', 'e_int', 'e_inel', 'log_strain']
 
 contains
-
-  !> Is a checkpoint due after this increment (*RESTART, WRITE of the step)? The element
-  !> driver's rule: at every multiple of the interval the increment reached or crossed.
-  logical function mpm_checkpoint_due(m, step, step_time, dt) result(due)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: step
-    real(dp), intent(in) :: step_time, dt
-    real(dp) :: interval, before
-
-    due = .false.
-    if (.not. m%steps(step)%restart_write) return
-    interval = m%steps(step)%restart_interval
-    if (interval <= 0) then
-       due = step_time >= m%steps(step)%period * (1 - 1.0e-12_dp)
-       return
-    end if
-    before = step_time - dt
-    due = floor(step_time / interval + 1.0e-9_dp) > floor(before / interval + 1.0e-9_dp)
-  end function mpm_checkpoint_due
 
   ! ------------------------------------------------------------------------------ writing
 

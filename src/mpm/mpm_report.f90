@@ -1,5 +1,5 @@
-!> What an MPM run reports: the header and the summary on standard output, the progress line,
-!> the history rows (masses, energies, centre of mass, wall forces; sums over ranks in rank
+!> What an MPM run reports: the header and the summary on standard output (the progress line
+!> and the end report's first lines are the run skeleton's, src/run), the history rows (masses, energies, centre of mass, wall forces; sums over ranks in rank
 !> order) and the field frames (every rank writes its own blocks through mpm_output).
 module mpm_report
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
@@ -7,33 +7,13 @@ module mpm_report
   use model, only: model_t
   use mpm_state, only: mpm_state_t, mpm_effects_t, n_fx, fx_names, sum_over_ranks, max_over_ranks
   use mpm_output, only: mpm_writer_t, mpm_writer_frame
-  use output_timer, only: timer_report, clock_text
   use output_history, only: history_t, history_row
   implicit none
   private
 
-  public :: header, summary, progress_line, history_columns, measure, write_history, write_frame
+  public :: header, summary, history_columns, measure, write_history, write_frame
 
 contains
-
-  !> "  step 2/2 DISCHARGE  t = 1.2345E+00  inc 12345  dt 1.234E-04  out kg (rank 0) 12.3  ETA 0:04:10":
-  !> the ETA from this run's wall time per simulated second so far (since the restart, if any).
-  subroutine progress_line(m, st, s, elapsed, sim_start)
-    type(model_t), intent(in) :: m
-    type(mpm_state_t), intent(in) :: st
-    integer, intent(in) :: s
-    real(dp), intent(in) :: elapsed, sim_start
-    real(dp) :: remaining, eta
-
-    remaining = m%steps(s)%period - st%step_time
-    if (s < m%n_steps) remaining = remaining + sum(m%steps(s + 1:m%n_steps)%period)
-    eta = 0
-    if (st%total_time > sim_start) eta = elapsed / (st%total_time - sim_start) * remaining
-    write (output_unit, '(a,i0,a,i0,1x,a,a,es11.4,a,i0,a,es10.3,a,es11.4,a,a)') '  step ', s, '/', m%n_steps, &
-         trim(m%steps(s)%name), '  t = ', st%total_time, '  inc ', st%increment, '  dt ', st%dt, &
-         '  out kg (rank 0) ', st%mass_out, '  ETA ', clock_text(eta)
-    flush (output_unit)
-  end subroutine progress_line
 
   !> A field frame: every rank writes its own blocks (collective; rows in rank order).
   subroutine write_frame(m, st, wr, step, step_time)
@@ -167,11 +147,11 @@ contains
     flush (output_unit)
   end subroutine header
 
-  subroutine summary(m, st, fx, stopped)
+  !> The MPM's lines of the end report (collective sums; rank 0 prints), after the skeleton's
+  !> "done" line; st%loop_seconds: the step loop's wall time.
+  subroutine summary(m, st)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    type(mpm_effects_t), intent(in) :: fx
-    logical, intent(in) :: stopped
     real(dp) :: g(8), rate
     integer :: ib, k
 
@@ -184,11 +164,7 @@ contains
     g(3:8) = [st%mass_out, real(st%n_out, dp), st%w_external, real(st%n_guarded, dp), &
          real(st%particle_steps, dp), 0.0_dp]
     call sum_over_ranks(st, g)
-    call timer_report(fx%timers, output_unit, st%comm)
     if (st%rank /= 0) return
-    if (stopped) write (output_unit, '(a,i0,a)') 'bulkflow: stopped after increment ', st%increment, &
-         ' as asked (--stop-after); continue with --restart'
-    write (output_unit, '(a,i0,a,es12.5)') 'bulkflow: done, ', st%increment, ' increments, t = ', st%total_time
     write (output_unit, '(a,i0,a,i0,a,i0,a)') '  particles ', nint(g(2)), ' (', st%n_in, ' in, ', nint(g(4)), ' out)'
     write (output_unit, '(a,4es14.6,a,es10.2)') '  mass      initial, in, out, now:', st%mass_initial, st%mass_in, &
          g(3), g(1), '  balance error', st%mass_initial + st%mass_in - g(3) - g(1)

@@ -41,7 +41,7 @@ module output_schedule
   end type output_schedule_t
 
   public :: field_schedule, history_schedule, schedule_from_requests, schedule_due, schedule_advance, &
-       schedule_resume, schedule_list_times, schedule_next_point
+       schedule_resume, schedule_list_times
 
 contains
 
@@ -152,18 +152,6 @@ contains
     t_prev = merge(-huge(1.0_dp), step_time - dt, step_increment == 0)
     due = any(sch%points > t_prev + tol .and. sch%points <= step_time + tol)
   end function schedule_due
-
-  !> The first listed time (TIME POINTS=) after step time `step_time` (by more than 1e-9·period,
-  !> the tolerance of schedule_due); huge when there is none. A solver cuts the increment that
-  !> would pass it to end on it.
-  pure real(dp) function schedule_next_point(sch, step_time) result(t)
-    type(output_schedule_t), intent(in) :: sch
-    real(dp), intent(in) :: step_time
-
-    t = huge(1.0_dp)
-    if (size(sch%points) == 0) return
-    t = minval(sch%points, mask=sch%points > step_time + 1.0e-9_dp * sch%period)
-  end function schedule_next_point
 
   !> After an output at step time `step_time`: every timed request's next time past it.
   pure subroutine schedule_advance(sch, step_time)

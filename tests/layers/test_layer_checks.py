@@ -65,7 +65,7 @@ def main() -> int:
 
         # An upward use: the model layer reaching into the element driver.
         up = fresh('upward')
-        line = inject_after_module(up / 'src/model/model_steps.f90', '  use driver_run, only: run_scene')
+        line = inject_after_module(up / 'src/model/model_steps.f90', '  use driver_run, only: one_increment')
         problems += expect(run(layers, up), 1,
                            f'src/model/model_steps.f90:{line}: forbidden upward use of driver_run',
                            'layers: upward use in src/model fails')
