@@ -173,11 +173,14 @@ contains
     character(len=*), intent(in) :: input_file !< for the message
     integer :: outside
     character(len=160) :: text
+    character(len=36) :: position
 
     call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%corner, &
          b%w1, b%dw1, outside)
     if (outside /= 0) then
-       write (text, '(a,i0,a,3es12.4,a,es12.5)') 'particle ', b%number(outside), ' at ', b%x(outside, :), &
+       ! the position apart: a 2D particle has two coordinates, fewer than the edit descriptors
+       write (position, '(3es12.4)') b%x(outside, :)
+       write (text, '(a,i0,a,a,a,es12.5)') 'particle ', b%number(outside), ' at ', trim(position), &
             ' left the background grid at t = ', st%total_time
        call raise_error(trim(input_file), 0, trim(text) // '; expected a *MPM GRID that covers the flow ' // &
             '(enlarge it, add walls or an *OUTFLOW)')
