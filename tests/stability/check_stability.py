@@ -20,10 +20,10 @@ import h5py
 import numpy as np
 
 CASES = {}
-# Not fixed (docs/stability.md, "Known failures"): on a column that barely moves on a frictional
-# floor (phi = 89 deg; psi = phi = 50 deg early on) ALLFD grows while ALLKE + ALLIE keeps up with
-# ALLWK, so ETOTAL rises: the wall-friction dissipation is over-booked, positions stay bounded.
-KNOWN_ALLFD = "ALLFD (wall friction) over-booked while ALLKE + ALLIE follows ALLWK; not fixed"
+# Not fixed (docs/stability.md, "Known failures"): a block at rest in a wall corner (ALLKE ~ 1e-22 J)
+# books wall-friction dissipation at a steady rate: grid nodes slip on one wall (the next wall's
+# projection, or the particles' weights, undo it), so ALLFD and ETOTAL rise. Positions stay put.
+KNOWN_ALLFD = "ALLFD (wall friction) grows at rest from node slip the particles do not follow; not fixed"
 
 
 def case(fn):
@@ -153,7 +153,7 @@ def dilation(args):
     2 % above its start); the
     dilating column must gain volume (sum of particle volumes grows), not lose it."""
     base, out, hist, fr = collapse(args, "dilation_50", phi=50.0, psi=50.0)
-    energy_not_created("dilation_50", hist, known=KNOWN_ALLFD)
+    energy_not_created("dilation_50", hist)
     v0, v1 = float(np.sum(fr[0]["volume"])), float(np.sum(fr[-1]["volume"]))
     check(v1 >= v0, f"dilation_50: volume {v0:.5f} -> {v1:.5f} m^2 (psi = 50 deg dilates)")
 
@@ -162,17 +162,19 @@ def dilation(args):
 def friction_extremes(args):
     """phi = 1 deg and 89 deg (psi = 0) beside 30 deg: finite, no energy created, and the
     outcome monotone in phi: the run-out falls as phi rises; at 89 deg the column stands (its top
-    within 2 % of 0.6 m), at 1 deg it spreads (top below half)."""
+    within 5 % of its start: c = 0 lets the free corners crumble) and the top rises with phi."""
     res = {}
     for phi in (1.0, 30.0, 89.0):
         name = f"friction_{phi:g}"
         base, out, hist, fr = collapse(args, name, phi=phi, psi=0.0)
-        energy_not_created(name, hist, known=KNOWN_ALLFD if phi == 89.0 else None)
+        energy_not_created(name, hist)
         res[phi] = runout(fr)
         print(f"      {name}: run-out {res[phi][0]:.4f} m, top {res[phi][1]:.4f} m")
     check(res[1.0][0] > res[30.0][0] > res[89.0][0], "run-out strictly falls as phi rises (1, 30, 89 deg)")
-    check(res[89.0][1] > 0.98 * 0.6 - 0.0125, f"phi = 89: the column stands (top {res[89.0][1]:.4f} m)")
-    check(res[1.0][1] < 0.3, f"phi = 1: the column spreads (top {res[1.0][1]:.4f} m)")
+    top0 = 0.6 - 0.0125  # the highest particle's centre at the start (2 PPC in 0.05 m cells)
+    check(res[89.0][1] > 0.95 * top0, f"phi = 89: the column stands (top {res[89.0][1]:.4f} m, > 95 % of {top0} m)")
+    check(res[1.0][1] < res[30.0][1] < res[89.0][1],
+          f"the top rises with phi ({res[1.0][1]:.4f}, {res[30.0][1]:.4f}, {res[89.0][1]:.4f} m)")
 
 
 @case
@@ -213,6 +215,89 @@ def tension_cutoff(args):
             p_max = 0.5 * (sxx + syy) + np.sqrt((0.5 * (sxx - syy)) ** 2 + sxy ** 2)
             worst = max(worst, float(np.max(p_max)), float(np.max(szz)))
         check(worst <= 1.0, f"{name}: largest principal stress over all frames {worst:.3e} Pa <= 1 Pa")
+
+
+def sand(E=5.0e6, phi=30.0):
+    return mpm_material("SAND", E, 0.3, phi, 0.0, 0.0)
+
+
+def step_text(time, extra=""):
+    return (f"*STEP, NAME=RUN\n*DYNAMIC, EXPLICIT\n, {time}\n*DLOAD\n, GRAV, 9.81, 0., -1.\n{extra}"
+            "*OUTPUT, FIELD, NUMBER INTERVAL=5\n*ELEMENT OUTPUT\nS\n"
+            "*OUTPUT, HISTORY, TIME INTERVAL=0.01\n*ENERGY OUTPUT\n*END STEP\n")
+
+
+@case
+def hopper_empty(args):
+    """A small wedge hopper (half model) with its outlet open and *OUTFLOW below, run until the
+    last particle has left and on for a while with none: exit 0, every history value finite, the
+    particle count never rises and reaches 0, the mass balance exact, the energy not created."""
+    scene = ("*HEADING\nstability: hopper emptied to the last particle\n"
+             "*MPM GRID, CELL=0.05, SHAPE=GIMP\n-0.2, -0.3\n0.6, 0.8\n*MPM CONTROLS, FLIP=0.99, CFL=0.4\n"
+             + sand() + "*PARTICLES, MATERIAL=SAND, PPC=2, TYPE=POLYGON\n0., 0.1\n0.1, 0.1\n0.3, 0.4\n0., 0.4\n"
+             "*MPM WALL, NAME=AXIS, TYPE=SYMMETRY\n0., 0.8, 0., -0.3\n"
+             "*MPM WALL, NAME=WALL, FRICTION=0.2\n0.1, 0.1, 0.5, 0.7\n*OUTFLOW, BELOW=0.0\n" + step_text(1.5))
+    base, out, hist = run(args, "hopper_empty", scene)
+    finite_history("hopper_empty", hist)
+    particle_balance("hopper_empty", hist)
+    n = hist["particles"]
+    check(np.all(np.diff(n) <= 0), "hopper_empty: the particle count never rises")
+    empty = np.nonzero(n == 0)[0]
+    check(len(empty) > 0, f"hopper_empty: emptied ({int(n[0])} -> {int(n[-1])} particles)")
+    print(f"      hopper_empty: empty from t = {hist['time'][empty[0]]:.3f} s of 1.5 s, "
+          f"{int(hist['increment'][-1])} increments")
+    check(hist["time"][-1] >= 1.5 - 1e-9 and hist["time"][empty[0]] < 1.4,
+          "hopper_empty: the run went on for at least 0.1 s with no particle")
+    energy_not_created("hopper_empty", hist)
+
+
+@case
+def inflow_bin(args):
+    """Inflow into a nearly empty bin: one particle row on the floor (a scene without particles is
+    refused by the reader, and inflow feeds only columns that hold material, docs/keywords.md),
+    *INFLOW keeping the level at 0.5 m. Stable: finite, mass balance exact, the count never
+    falls, the surface rises from 0.1 m and never passes the level by more than a cell."""
+    scene = ("*HEADING\nstability: inflow into an empty bin\n"
+             "*MPM GRID, CELL=0.05, SHAPE=GIMP\n-0.2, -0.2\n0.6, 0.8\n*MPM CONTROLS, FLIP=0.99, CFL=0.4\n"
+             + sand() + "*PARTICLES, MATERIAL=SAND, PPC=2\n0., 0.\n0.3, 0.025\n"
+             "*MPM WALL, NAME=AXIS, TYPE=SYMMETRY\n0., 0.8, 0., -0.2\n"
+             "*MPM WALL, NAME=SIDE, FRICTION=0.3\n0.3, -0.2, 0.3, 0.8\n"
+             "*MPM WALL, NAME=FLOOR, FRICTION=0.3\n-0.2, 0., 0.6, 0.\n"
+             + step_text(0.6, "*INFLOW, MATERIAL=SAND, LEVEL=0.5\n0., 0.3\n"))
+    base, out, hist = run(args, "inflow_bin", scene)
+    finite_history("inflow_bin", hist)
+    particle_balance("inflow_bin", hist)
+    n = hist["particles"]
+    check(np.all(np.diff(n) >= 0) and n[-1] > 5 * n[0],
+          f"inflow_bin: the count never falls and grows ({int(n[0])} -> {int(n[-1])})")
+    top = hist["YTOP"]
+    check(np.max(top) <= 0.5 + 0.05, f"inflow_bin: the surface stays below level + 1 cell (max {np.max(top):.4f} m)")
+    check(top[-1] > 0.4, f"inflow_bin: the surface rose to {top[-1]:.4f} m")
+
+
+@case
+def corner(args):
+    """Particles exactly in wall corners and on a symmetry plane (all on grid node lines): a block
+    in the corner of the floor and a frictional side wall, touching the symmetry plane x = 0.
+    Stable: finite, no particle centre behind a wall or the plane at the end of any frame (beyond
+    1e-9 m), the block comes to rest (ALLKE at the end below 1 % of its peak), no energy created."""
+    scene = ("*HEADING\nstability: particles in a wall corner and on a symmetry plane\n"
+             "*MPM GRID, CELL=0.05, SHAPE=GIMP\n-0.2, -0.2\n0.6, 0.6\n*MPM CONTROLS, FLIP=0.99, CFL=0.4, DAMPING=0.2\n"
+             + sand() + "*PARTICLES, MATERIAL=SAND, PPC=2\n0., 0.\n0.3, 0.2\n"
+             "*MPM WALL, NAME=AXIS, TYPE=SYMMETRY\n0., 0.6, 0., -0.2\n"
+             "*MPM WALL, NAME=SIDE, FRICTION=0.4\n0.3, -0.2, 0.3, 0.6\n"
+             "*MPM WALL, NAME=FLOOR, FRICTION=0.4\n-0.2, 0., 0.6, 0.\n" + step_text(0.5))
+    base, out, hist = run(args, "corner", scene)
+    finite_history("corner", hist)
+    particle_balance("corner", hist)
+    for k, f in enumerate(frames(base)):
+        x = f["coordinates"]
+        check(np.min(x[:, 0]) >= -1e-9 and np.max(x[:, 0]) <= 0.3 + 1e-9 and np.min(x[:, 1]) >= -1e-9,
+              f"corner: frame {k}: particles within x in [0, 0.3], y >= 0 "
+              f"({np.min(x[:, 0]):.3e}, {np.max(x[:, 0]):.6f}, {np.min(x[:, 1]):.3e})")
+    ke = hist["ALLKE"]
+    check(ke[-1] <= 0.01 * np.max(ke), f"corner: at rest (ALLKE {ke[-1]:.3e} J, peak {np.max(ke):.3e} J)")
+    energy_not_created("corner", hist, known=KNOWN_ALLFD)
 
 
 def main():
