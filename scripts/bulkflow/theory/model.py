@@ -268,11 +268,11 @@ def critical_width_estimates(hopper: Hopper, material: Material, *,
         return jenike.critical_width_general(ff, m.rho, H, sigma1_of_B, g)
 
     def checked_width(H, label):
-        # A thin arch needs sin 2β > 0: β = θ + ω_p ≥ 90° (a wall rougher than the material,
+        # A thin arch needs sin 2β ≥ 0: β = θ + ω_p > 90° (a wall rougher than the material,
         # φ_w near or above δ, on a steep hopper) leaves eq. 6.4 without an arch; its width
         # would come out negative, which is no width at all.
-        if H <= 0.0:
-            notes.append(f"{label}: sin 2beta = {H:.3g} <= 0 (beta >= 90 deg, wall friction {m.phi_w_deg} deg "
+        if H < 0.0:
+            notes.append(f"{label}: sin 2beta = {H:.3g} < 0 (beta > 90 deg, wall friction {m.phi_w_deg} deg "
                          f"against delta {delta:.3g} deg): no thin arch, width nan")
             return math.nan
         return width(H)
@@ -282,7 +282,7 @@ def critical_width_estimates(hopper: Hopper, material: Material, *,
     by_beta = {}
     for reading in jenike.JENIKE_BETA_READINGS:
         H_r = jenike.H_from_beta(jenike.jenike_beta(theta, delta, m.phi_w_deg, reading))
-        by_beta[reading] = width(H_r) if H_r > 0.0 else math.nan
+        by_beta[reading] = width(H_r) if H_r >= 0.0 else math.nan
 
     def s1_at(B):
         if not math.isfinite(B):
