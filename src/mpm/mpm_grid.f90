@@ -1,6 +1,7 @@
 !> The structured background grid: node arrays reset every increment (the grid carries no
 !> history). Node (i, j[, k]) (0-based) has index 1 + i + n1 (j + n2 k) and position lo + (i, j, k) h.
 module mpm_grid
+  use, intrinsic :: iso_fortran_env, only: int64
   use base_kinds, only: dp
   implicit none
   private
@@ -24,6 +25,7 @@ module mpm_grid
   end type grid_t
 
   public :: grid_init, grid_reset, grid_reset_sums, grid_node_index, grid_clear
+  public :: grid_node_count, grid_sum_length
 
 contains
 
@@ -41,11 +43,26 @@ contains
        ! nodes up to the first node line at or beyond hi
        g%n(k) = ceiling((hi(k) - lo(k)) / h - 1.0e-9_dp) + 1
     end do
-    g%nn = product(g%n)
+    ! the reader refused grids beyond 2147483647 nodes (scene_mpm check_mpm_size): nn fits
+    g%nn = int(grid_node_count(g%n))
     allocate (g%mass(g%nn), g%mass_own(g%nn), g%mom(ndim, g%nn), g%force(ndim, g%nn), g%v_old(ndim, g%nn), &
          g%v_new(ndim, g%nn), g%active(g%nn))
     call grid_reset(g)
   end subroutine grid_init
+
+  !> Nodes of a grid with n(k) nodes per direction, in 64 bits: a product of counts that a
+  !> small cell takes beyond 2^31 (issue 16).
+  pure integer(int64) function grid_node_count(n) result(count)
+    integer, intent(in) :: n(3)
+    count = product(int(n, int64))
+  end function grid_node_count
+
+  !> Values one reduction of the grid's mass, momentum and force moves over the ranks,
+  !> nn (1 + 2 ndim): beyond 2^31 already for 3D grids of 307 M nodes.
+  pure integer(int64) function grid_sum_length(nn, ndim) result(length)
+    integer, intent(in) :: nn, ndim
+    length = int(nn, int64) * (1 + 2 * ndim)
+  end function grid_sum_length
 
   subroutine grid_reset(g)
     type(grid_t), intent(inout) :: g

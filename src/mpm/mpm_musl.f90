@@ -5,12 +5,13 @@
 !> x^{n+1} with v^{n+1}, the grid's v_new the remapped velocity the stress update takes its
 !> gradient from.
 module mpm_musl
+  use, intrinsic :: iso_fortran_env, only: int64
   use base_kinds, only: dp
   use error_report, only: raise_error
   use model, only: model_t
   use model_time_variation, only: variation_factor
   use mpm_state, only: mpm_state_t, mpm_effects_t, fx_p2g, fx_grid, fx_g2p, fx_walls, max_over_ranks, det_f
-  use mpm_grid, only: grid_reset_sums, grid_clear
+  use mpm_grid, only: grid_sum_length, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t
   use mpm_shape, only: block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum
@@ -147,19 +148,19 @@ contains
     type(mpm_state_t), intent(inout) :: st
     logical, intent(in) :: all_fields
     real(dp), allocatable :: buf(:)
-    integer :: nn, nd
+    integer(int64) :: nn, nv     ! nn (1 + 2 nd) passes 2^31 for large 3D grids
 
     nn = st%g%nn
-    nd = st%nd
+    nv = st%nd * nn
     if (all_fields) then
-       allocate (buf(nn * (1 + 2 * nd)))
+       allocate (buf(grid_sum_length(st%g%nn, st%nd)))
        buf(1:nn) = st%g%mass
-       buf(nn + 1:nn + nd * nn) = reshape(st%g%mom, [nd * nn])
-       buf(nn + nd * nn + 1:) = reshape(st%g%force, [nd * nn])
+       buf(nn + 1:nn + nv) = reshape(st%g%mom, [nv])
+       buf(nn + nv + 1:) = reshape(st%g%force, [nv])
        call comm_sum(st%comm, buf)
        st%g%mass = buf(1:nn)
-       st%g%mom = reshape(buf(nn + 1:nn + nd * nn), [nd, nn])
-       st%g%force = reshape(buf(nn + nd * nn + 1:), [nd, nn])
+       st%g%mom = reshape(buf(nn + 1:nn + nv), [st%nd, st%g%nn])
+       st%g%force = reshape(buf(nn + nv + 1:), [st%nd, st%g%nn])
     else
        call comm_sum(st%comm, st%g%mom)
     end if
@@ -173,11 +174,14 @@ contains
     character(len=*), intent(in) :: input_file !< for the message
     integer :: outside
     character(len=160) :: text
+    character(len=36) :: position
 
     call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%corner, &
          b%w1, b%dw1, outside)
     if (outside /= 0) then
-       write (text, '(a,i0,a,3es12.4,a,es12.5)') 'particle ', b%number(outside), ' at ', b%x(outside, :), &
+       ! the position apart: a 2D particle has two coordinates, fewer than the edit descriptors
+       write (position, '(3es12.4)') b%x(outside, :)
+       write (text, '(a,i0,a,a,a,es12.5)') 'particle ', b%number(outside), ' at ', trim(position), &
             ' left the background grid at t = ', st%total_time
        call raise_error(trim(input_file), 0, trim(text) // '; expected a *MPM GRID that covers the flow ' // &
             '(enlarge it, add walls or an *OUTFLOW)')

@@ -96,8 +96,15 @@ contains
     call sum_over_ranks(st, g)
     call max_over_ranks(st, top)
     mass = g(1)
-    xcm = g(2:4) / mass
-    vcm = g(5:7) / mass
+    ! an emptied domain has no centre of mass and no top: 0, not 0/0 (tests/stability hopper-empty)
+    xcm = 0
+    vcm = 0
+    if (g(8) > 0) then
+       xcm = g(2:4) / mass
+       vcm = g(5:7) / mass
+    else
+       top = 0
+    end if
     mass_out = g(9)
     mdr = 0
     if (st%total_time > last_time) mdr = (mass_out - last_out) / (st%total_time - last_time)

@@ -123,9 +123,12 @@ contains
   end subroutine wall_find_nodes
 
   !> Project the velocities v(ndim, nn) of the wall's active nodes; with `force`, add the
-  !> force the material exerts on the wall, −Σ m Δv / Δt, and the kinetic energy friction takes
-  !> out of the tangential motion, Σ ½ m (|v_t|² − |v_t,new|²) >= 0, into `dissipated` (the
-  !> normal velocity a wall removes is the reaction to the stress of a resting body, not a loss).
+  !> force the material exerts on the wall, −Σ m Δv / Δt, and the work friction does on the
+  !> slip, Σ m (|v_t| − |v_t,new|) |v_t,new| >= 0 (friction force times the slip the particles
+  !> move with, times Δt), into `dissipated`. Not ½ m (|v_t|² − |v_t,new|²): the trial velocity
+  !> v_t never was kinetic energy, and a body resting on the wall (stick, v_t,new = 0) would book
+  !> ½ m v_t² every increment (ETOTAL rising linearly at rest; tests/stability corner). The
+  !> normal velocity a wall removes is the reaction to the stress of a resting body, not a loss.
   subroutine wall_project(w, wn, ndim, mass, active, v, dt, force, dissipated)
     type(mpm_wall_t), intent(in) :: w
     type(wall_nodes_t), intent(in) :: wn
@@ -156,8 +159,8 @@ contains
           call coulomb_slide(w%friction, vi, vn, n, vnew, tn, scale)
        end if
        if (present(force)) force = force - mass(i) * (vnew - vi) / dt
-       if (present(dissipated) .and. w%kind /= wall_symmetry) dissipated = dissipated + 0.5_dp * mass(i) * &
-            tn * tn * (1 - scale * scale)
+       if (present(dissipated) .and. w%kind /= wall_symmetry) dissipated = dissipated + mass(i) * &
+            tn * tn * scale * (1 - scale)
        v(:, i) = vnew(1:ndim)
     end do
   end subroutine wall_project

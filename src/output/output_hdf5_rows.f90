@@ -3,7 +3,8 @@
 !> collective transfer (each rank's block a single hyperslab; see redistribute for why).
 module output_hdf5_rows
   use, intrinsic :: iso_c_binding, only: c_loc
-  use mpi_f08, only: MPI_Comm, MPI_Alltoall, MPI_Alltoallv, MPI_INTEGER, MPI_DOUBLE_PRECISION
+  use mpi_f08, only: MPI_Comm, MPI_Datatype, MPI_Alltoall, MPI_Alltoallv, MPI_INTEGER, MPI_DOUBLE_PRECISION, &
+       MPI_Type_contiguous, MPI_Type_commit, MPI_Type_free
   use hdf5
   use base_kinds, only: dp
   use error_report, only: raise_error
@@ -76,6 +77,7 @@ contains
     real(dp), allocatable :: recv_values(:, :)
     logical, allocatable :: seen(:)
     integer :: k, r, p, n_recv
+    type(MPI_Datatype) :: row_type
 
     p = nranks
     allocate (send_counts(0:p - 1), send_displs(0:p - 1), recv_counts(0:p - 1), &
@@ -97,8 +99,13 @@ contains
     ! Rows are ascending, so the rows for each destination are consecutive in `rows`.
     call MPI_Alltoallv(rows, send_counts, send_displs, MPI_INTEGER, recv_rows, recv_counts, &
          recv_displs, MPI_INTEGER, comm)
-    call MPI_Alltoallv(buf, ncomp * send_counts, ncomp * send_displs, MPI_DOUBLE_PRECISION, &
-         recv_values, ncomp * recv_counts, ncomp * recv_displs, MPI_DOUBLE_PRECISION, comm)
+    ! counted in rows of ncomp values, not in values: ncomp times a displacement in rows passes
+    ! 2^31 from 358 M rows of six components, and MPI counts are default integers
+    call MPI_Type_contiguous(ncomp, MPI_DOUBLE_PRECISION, row_type)
+    call MPI_Type_commit(row_type)
+    call MPI_Alltoallv(buf, send_counts, send_displs, row_type, &
+         recv_values, recv_counts, recv_displs, row_type, comm)
+    call MPI_Type_free(row_type)
 
     call block_of(nrows, p, rank, first, count)
     allocate (block(ncomp, count), seen(count))

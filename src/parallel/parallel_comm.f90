@@ -29,6 +29,7 @@ module parallel_comm
   public :: comm_bcast
   public :: comm_sum_exact
   public :: comm_max_owner, comm_send, comm_recv
+  public :: comm_sum_pieces
 
   !> True on every rank where the flag is true on at least one rank (arrays: element by element).
   interface comm_any
@@ -82,6 +83,8 @@ module parallel_comm
   integer, parameter :: acc_lsb = -1126
   integer, parameter :: acc_flush = 2**30
   integer(int64), parameter :: digit_mask = int(z'FFFFFFFF', int64)
+  !> Most values one MPI reduction call carries (comm_sum_pieces).
+  integer(int64), parameter, public :: max_reduce_count = 2_int64**30
 
 contains
 
@@ -238,14 +241,34 @@ contains
   subroutine sum_real_array(comm, x)
     type(MPI_Comm), intent(in) :: comm
     real(dp), contiguous, intent(inout) :: x(:)
-    call MPI_Allreduce(MPI_IN_PLACE, x, size(x), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+    call comm_sum_pieces(comm, x, size(x, kind=int64), max_reduce_count)
   end subroutine sum_real_array
 
   subroutine sum_real_matrix(comm, x)
     type(MPI_Comm), intent(in) :: comm
     real(dp), contiguous, intent(inout) :: x(:, :)
-    call MPI_Allreduce(MPI_IN_PLACE, x, size(x), MPI_DOUBLE_PRECISION, MPI_SUM, comm)
+    call comm_sum_pieces(comm, x, size(x, kind=int64), max_reduce_count)
   end subroutine sum_real_matrix
+
+  !> In-place sum of the n values of x over the ranks, `piece` values per MPI call at most: an
+  !> MPI count is a default integer, and a replicated 3D grid of 307 M nodes already sums more
+  !> than 2^31 − 1 values at once (mpm_musl). n is 64-bit; below `piece` it is one call, as
+  !> before. Public with its piece size for the test of the splitting.
+  subroutine comm_sum_pieces(comm, x, n, piece)
+    type(MPI_Comm), intent(in) :: comm
+    integer(int64), intent(in) :: n
+    real(dp), intent(inout) :: x(n)
+    integer(int64), intent(in) :: piece
+    integer(int64) :: first, count
+
+    first = 1
+    do while (first <= n)
+       count = min(piece, n - first + 1)
+       call MPI_Allreduce(MPI_IN_PLACE, x(first:first + count - 1), int(count), MPI_DOUBLE_PRECISION, &
+            MPI_SUM, comm)
+       first = first + count
+    end do
+  end subroutine comm_sum_pieces
 
   ! --- broadcasts ------------------------------------------------------------------------------
 

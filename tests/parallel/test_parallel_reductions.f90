@@ -8,7 +8,7 @@ program test_parallel_reductions
   use material_kinds, only: dp
   use model_mesh, only: mesh_t
   use parallel_comm, only: comm_rank, comm_size, comm_barrier, comm_min, comm_max, comm_sum, &
-       comm_any, comm_bcast, comm_sum_exact
+       comm_any, comm_bcast, comm_sum_exact, comm_sum_pieces
   use parallel_partition, only: partition_t, partition_mesh
   use parallel_assembly, only: global_min, global_max, global_sum, global_sum_exact
   use parallel_test_support, only: quad_mesh, contribution, check, check_summary, same_bits, eq
@@ -26,6 +26,7 @@ program test_parallel_reductions
   call check_partition_reductions()
   call check_broadcasts()
   call check_exact_sums()
+  call check_sum_in_pieces()
   call comm_barrier(comm)
 
   failed = check_summary(comm, 'test_parallel_reductions')
@@ -33,6 +34,29 @@ program test_parallel_reductions
   if (failed > 0) error stop 1
 
 contains
+
+  !> A sum split into MPI calls of at most `piece` values (how arrays beyond 2^31 values are
+  !> reduced) gives the bits of the sum in one call, for pieces that divide the length and not.
+  subroutine check_sum_in_pieces()
+    use, intrinsic :: iso_fortran_env, only: int64
+    real(dp) :: whole(23), split(23), matrix(3, 5)
+    integer :: i, piece
+
+    do i = 1, 23
+       whole(i) = (rank + 1) * 0.1_dp * i + 1.0_dp / (i + rank)
+    end do
+    split = whole
+    call comm_sum(comm, whole)
+    do piece = 1, 24
+       split = [((rank + 1) * 0.1_dp * i + 1.0_dp / (i + rank), i = 1, 23)]
+       call comm_sum_pieces(comm, split, 23_int64, int(piece, int64))
+       call check(same_bits(split, whole), 'comm_sum_pieces equals one comm_sum', rank)
+    end do
+    matrix = reshape([(real(i * (rank + 1), dp), i = 1, 15)], [3, 5])
+    call comm_sum(comm, matrix)
+    call check(all(eq(matrix, reshape([(real(i * nranks * (nranks + 1) / 2, dp), i = 1, 15)], [3, 5]))), &
+         'comm_sum of a matrix (through comm_sum_pieces)', rank)
+  end subroutine check_sum_in_pieces
 
   subroutine check_plain_reductions()
     integer :: i, ia(3)

@@ -253,7 +253,10 @@ def main(argv=None):
         return 0
     if not args.case and args.theta is None and args.rho is None:
         parser.error("give --case, a full material/hopper description, or --table-6-3")
-    m, h = _material_hopper(args, parser)
+    try:
+        m, h = _material_hopper(args, parser)
+    except ValueError as err:
+        parser.error(str(err))
     est = critical_width_estimates(h, m, **readings)
     ex = _extras(h, m, est, args)
     sweep = None

@@ -68,9 +68,13 @@ class BilinearFlowFunction:
 
     @property
     def k_low(self) -> float:
-        """Slope of the low-stress branch: (σ₁* − ratio f_c0)/σ₁*."""
-        s = self.sigma_merge
-        return (s - self.fc0_bilinear) / s
+        """Slope of the low-stress branch: (σ₁* − ratio f_c0)/σ₁*, which with σ₁* = f_c0/(1 − k)
+        is 1 − ratio (1 − k) for every f_c0. Written in that closed form so that a cohesionless
+        material (f_c0 = 0, σ₁* = 0: the low branch shrinks to the origin and the function is
+        k σ₁) has a slope instead of 0/0."""
+        if self.k >= 1.0:
+            raise ValueError("k >= 1: the linear flow function never meets f_c = sigma1")
+        return 1.0 - self.ratio * (1.0 - self.k)
 
     def __call__(self, sigma1):
         s1 = np.asarray(sigma1, dtype=float)

@@ -127,6 +127,15 @@ class Hopper:
         """Outlet width B = 2 r sin θ for an outlet edge at wall distance r."""
         return 2.0 * r * math.sin(math.radians(self.theta_deg))
 
+    def __post_init__(self):
+        # θ = 0 is a vertical channel: no apex, no radial field, r_out = B/(2 sin θ) infinite.
+        # The wedge theories have no limit there, so say so instead of dividing by zero.
+        if not 0.0 < self.theta_deg < 90.0:
+            raise ValueError(f"hopper half-angle theta = {self.theta_deg} deg: the wedge theories need "
+                             "0 < theta < 90 (theta = 0 is a vertical channel without an apex)")
+        if not self.height > 0.0:
+            raise ValueError(f"hopper height = {self.height} m: must be > 0 (above the apex)")
+
     def replace(self, **kw) -> "Hopper":
         d = asdict(self)
         d.update(kw)
@@ -258,11 +267,22 @@ def critical_width_estimates(hopper: Hopper, material: Material, *,
             return jenike.critical_width_closed_form(m.fc0, m.k, m.rho, H, S if math.isfinite(S) else 0.0, g)
         return jenike.critical_width_general(ff, m.rho, H, sigma1_of_B, g)
 
+    def checked_width(H, label):
+        # A thin arch needs sin 2β ≥ 0: β = θ + ω_p > 90° (a wall rougher than the material,
+        # φ_w near or above δ, on a steep hopper) leaves eq. 6.4 without an arch; its width
+        # would come out negative, which is no width at all.
+        if H < 0.0:
+            notes.append(f"{label}: sin 2beta = {H:.3g} < 0 (beta > 90 deg, wall friction {m.phi_w_deg} deg "
+                         f"against delta {delta:.3g} deg): no thin arch, width nan")
+            return math.nan
+        return width(H)
+
     B_mclean = width(H_m)
-    B_jenike = width(H_j)
+    B_jenike = checked_width(H_j, "jenike")
     by_beta = {}
     for reading in jenike.JENIKE_BETA_READINGS:
-        by_beta[reading] = width(jenike.H_from_beta(jenike.jenike_beta(theta, delta, m.phi_w_deg, reading)))
+        H_r = jenike.H_from_beta(jenike.jenike_beta(theta, delta, m.phi_w_deg, reading))
+        by_beta[reading] = width(H_r) if H_r >= 0.0 else math.nan
 
     def s1_at(B):
         if not math.isfinite(B):
