@@ -140,6 +140,9 @@ contains
     integer(hid_t) :: file_space, mem_space
     integer :: hdferr, first, count
 
+    ! a dataset of no rows (an emptied MPM domain) has no storage for HDF5 to write into; every
+    ! rank sees the same dimensions, so all of them skip the collective write alike
+    if (dataset_rows(dset) == 0) return
     call redistribute(comm, rank, nranks, path, ncomp, dataset_rows(dset), rows, buf, first, count, block)
     call block_spaces(dset, ncomp, first, count, file_space, mem_space)
     idle = 0.0_dp
@@ -170,6 +173,9 @@ contains
     integer(hid_t) :: file_space, mem_space
     integer :: hdferr, first, count
 
+    ! a dataset of no rows (an emptied MPM domain) has no storage for HDF5 to write into; every
+    ! rank sees the same dimensions, so all of them skip the collective write alike
+    if (dataset_rows(dset) == 0) return
     allocate (rbuf(size(buf, 1), size(buf, 2)))
     rbuf = real(buf, dp)
     call redistribute(comm, rank, nranks, path, ncomp, dataset_rows(dset), rows, rbuf, first, count, block)
