@@ -126,6 +126,16 @@ contains
             end if
           end associate
        end do
+       ! the work of the moving walls on the material, −F·v_w Δt (ALLWK; the grid and so the
+       ! forces are the same on every rank: counted on rank 0)
+       if (st%rank == 0) then
+          do k = 1, size(m%mpm%walls)
+             associate (w => m%mpm%walls(k))
+               if (w%surface > 0 .and. w%active(s)) st%w_external = st%w_external - &
+                    st%dt * dot_product(st%wall_force(:, k), st%rigid_v(:, w%surface))
+             end associate
+          end do
+       end if
        st%wall_impulse = st%wall_impulse + st%dt * st%wall_force
        st%impulse_time = st%impulse_time + st%dt
        call timer_stop(fx%timers, fx%id(fx_walls))
