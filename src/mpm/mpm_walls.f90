@@ -216,10 +216,10 @@ contains
   ! ------------------------------------------------------------------------------------------
 
   !> The grid nodes on or behind the rigid surface `surf` translated by `offset` (its position
-  !> at t_n+1): gap <= node_on_wall_tolerance·h, with the surface's unit normal at each. All
-  !> nodes, active or not (the list marks the nodes local damping leaves alone before the grid
-  !> update decides which are active). Why every increment: a moving wall sweeps over node
-  !> lines; a fixed one gets the same list.
+  !> at t_n+1): gap <= node_on_wall_tolerance·h, with the surface's unit normal at each. Every
+  !> node with mass (called after P2G, before the grid update decides which are active: the list
+  !> also marks the nodes local damping leaves alone); a node without mass is never active. Why
+  !> every increment: a moving wall sweeps over node lines; a fixed one gets the same list.
   subroutine surface_find_nodes(surf, offset, g, wn)
     type(rigid_surface_t), intent(in) :: surf
     real(dp), intent(in) :: offset(3)
@@ -235,6 +235,7 @@ contains
     allocate (list(g%nn), nrm(3, g%nn))
     n = 0
     do i = 1, g%nn
+       if (.not. g%mass(i) > 0) cycle
        x = g%position(i)
        normal = 0
        call surface_closest_point(surf, offset(1:nd), x(1:nd), gap, normal(1:nd), cp(1:nd))
