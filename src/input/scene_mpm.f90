@@ -10,7 +10,11 @@
 !>   *OUTFLOW, BELOW=y                              model data: particles below y leave
 !>   *INFLOW, MATERIAL=name, LEVEL=y [, PPC=n]      in a step: data x1, x2 (3D: x1, z1, x2, z2)
 !>
-!> A scene with *MPM GRID is a material-point scene: it has no *NODE or *ELEMENT mesh; its
+!> Rigid surfaces are walls too: *SURFACE, TYPE=SEGMENTS|PLANE (+ *RIGID BODY on a *NODE moved by
+!> *BOUNDARY) paired with the particles by *CONTACT PAIR with a blank first field
+!> (attach_surface_walls appends them to the walls; src/mpm/mpm_walls.f90 evaluates them).
+!>
+!> A scene with *MPM GRID is a material-point scene: it has no *ELEMENT mesh; its
 !> materials, amplitudes, steps (*DYNAMIC, EXPLICIT, *DLOAD GRAV, *OUTPUT) are the usual ones.
 !> "Up" is +y (axis 2) in 2D and 3D. The checks end with `file:line: what; expected ...`.
 module scene_mpm
