@@ -21,6 +21,7 @@ module scene_mesh
   private
 
   public :: mesh_sources_t, build_mesh
+  public :: read_nodes   ! the reference nodes of an MPM scene's rigid bodies (scene_reader)
 
   !> Where each internal element was defined (for later messages about elements).
   type :: mesh_sources_t

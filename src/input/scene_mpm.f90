@@ -10,7 +10,11 @@
 !>   *OUTFLOW, BELOW=y                              model data: particles below y leave
 !>   *INFLOW, MATERIAL=name, LEVEL=y [, PPC=n]      in a step: data x1, x2 (3D: x1, z1, x2, z2)
 !>
-!> A scene with *MPM GRID is a material-point scene: it has no *NODE or *ELEMENT mesh; its
+!> Rigid surfaces are walls too: *SURFACE, TYPE=SEGMENTS|PLANE (+ *RIGID BODY on a *NODE moved by
+!> *BOUNDARY) paired with the particles by *CONTACT PAIR with a blank first field
+!> (attach_surface_walls appends them to the walls; src/mpm/mpm_walls.f90 evaluates them).
+!>
+!> A scene with *MPM GRID is a material-point scene: it has no *ELEMENT mesh; its
 !> materials, amplitudes, steps (*DYNAMIC, EXPLICIT, *DLOAD GRAV, *OUTPUT) are the usual ones.
 !> "Up" is +y (axis 2) in 2D and 3D. The checks end with `file:line: what; expected ...`.
 module scene_mpm
@@ -28,7 +32,7 @@ module scene_mpm
   implicit none
   private
 
-  public :: is_mpm_scene, check_mpm_keywords, build_mpm, mpm_keyword
+  public :: is_mpm_scene, check_mpm_keywords, build_mpm, mpm_keyword, mpm_has_nodes, attach_surface_walls
 
 contains
 
@@ -56,12 +60,14 @@ contains
     end do
   end function is_mpm_scene
 
-  !> MPM keywords need *MPM GRID; an MPM scene takes no mesh keywords (no FEM-MPM coupling yet).
+  !> MPM keywords need *MPM GRID; an MPM scene takes no mesh keywords (no FEM-MPM coupling yet),
+  !> but rigid surfaces with their reference nodes, interactions, contact pairs and *BOUNDARY.
   subroutine check_mpm_keywords(deck, grid_block, err)
     type(keyword_deck_t), intent(in) :: deck
     integer, intent(in) :: grid_block
     type(error_t), intent(inout) :: err
     integer :: i
+    character(len=:), allocatable :: stype
 
     do i = 1, deck%n_blocks
        associate (blk => deck%blocks(i))
@@ -73,12 +79,24 @@ contains
             end if
          else
             select case (blk%name)
-            case ('NODE', 'ELEMENT', 'NSET', 'ELSET', 'SOLID SECTION', 'SECTION CONTROLS', 'SURFACE', &
-                 'RIGID BODY', 'SURFACE INTERACTION', 'FRICTION', 'CONTACT PAIR', 'BOUNDARY')
+            case ('ELEMENT', 'ELSET', 'SOLID SECTION', 'SECTION CONTROLS')
                call blk%fail('*' // blk%name // ' in a material-point scene (*MPM GRID at ' // &
                     where_text(deck%blocks(grid_block)%file, deck%blocks(grid_block)%line) // &
                     '); expected MPM keywords (*PARTICLES, *MPM WALL, ...): meshes and MPM do not mix yet', err)
                return
+            case ('SURFACE')
+               ! rigid surfaces (walls) only: there are no element faces
+               if (blk%has_param('TYPE')) then
+                  call blk%get_string('TYPE', stype, err)
+                  if (err%raised) return
+               else
+                  stype = 'ELEMENT'
+               end if
+               if (stype == 'ELEMENT') then
+                  call blk%fail('*SURFACE, TYPE=ELEMENT in a material-point scene; expected TYPE=SEGMENTS ' // &
+                       '(2D) or TYPE=PLANE (3D): a rigid surface paired with the particles by *CONTACT PAIR', err)
+                  return
+               end if
             case ('MPM GRID')
                if (i /= grid_block) then
                   call blk%fail('second *MPM GRID (first at ' // where_text(deck%blocks(grid_block)%file, &
@@ -565,4 +583,93 @@ contains
     end if
     c%inflow%on = .true.
   end subroutine read_inflow
+
+  !> Does the deck name nodes (reference nodes of rigid bodies, their sets or conditions)?
+  pure logical function mpm_has_nodes(deck)
+    type(keyword_deck_t), intent(in) :: deck
+    integer :: i
+    mpm_has_nodes = .false.
+    do i = 1, deck%n_blocks
+       select case (deck%blocks(i)%name)
+       case ('NODE', 'NSET', 'RIGID BODY', 'BOUNDARY')
+          mpm_has_nodes = .true.
+       end select
+    end do
+  end function mpm_has_nodes
+
+  !> The rigid surfaces the steps pair with the particles (*CONTACT PAIR with a blank first
+  !> field) become walls of the MPM scene, after the *MPM WALLs: one wall per surface, named
+  !> after it, active in the steps whose pairs name it, with the friction of its interaction.
+  !> Every node of the scene must be a rigid body's reference node (nothing else has nodes).
+  subroutine attach_surface_walls(deck, layout, model, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(scene_layout_t), intent(in) :: layout
+    type(model_t), intent(inout) :: model
+    type(error_t), intent(inout) :: err
+    type(mpm_wall_t), allocatable :: walls(:)
+    integer :: s, j, r, k, n0, nsteps
+    integer, allocatable :: wall_of(:)
+    real(dp) :: mu
+
+    call check_reference_nodes(deck, layout, model, err)
+    if (err%raised) return
+    nsteps = max(model%n_steps, 1)
+    allocate (wall_of(model%n_rigid_surfaces))
+    wall_of = 0
+    n0 = size(model%mpm%walls)
+    walls = model%mpm%walls
+    do s = 1, model%n_steps
+       if (.not. allocated(model%steps(s)%contact_pairs)) cycle
+       do j = 1, size(model%steps(s)%contact_pairs)
+          associate (cp => model%steps(s)%contact_pairs(j))
+            r = cp%rigid_surface
+            mu = 0
+            if (cp%interaction > 0) mu = model%interactions(cp%interaction)%friction
+            if (wall_of(r) == 0) then
+               do k = 1, n0
+                  if (walls(k)%name == model%rigid_surfaces(r)%name) then
+                     call deck%blocks(1)%fail('rigid surface ' // trim(model%rigid_surfaces(r)%name) // &
+                          ' has the name of *MPM WALL ' // trim(walls(k)%name) // ' (' // trim(walls(k)%source) // &
+                          '); expected distinct wall names (they name the history columns)', err)
+                     return
+                  end if
+               end do
+               walls = [walls, mpm_wall_t(name=model%rigid_surfaces(r)%name, friction=mu, surface=r)]
+               wall_of(r) = size(walls)
+               allocate (walls(wall_of(r))%active(nsteps))
+               walls(wall_of(r))%active = .false.
+               walls(wall_of(r))%source = 'rigid surface ' // trim(model%rigid_surfaces(r)%name)
+            else if (abs(walls(wall_of(r))%friction - mu) > 0) then
+               call deck%blocks(layout%step_block(s))%fail('rigid surface ' // &
+                    trim(model%rigid_surfaces(r)%name) // ' is paired with friction ' // rtoa(mu) // &
+                    ' in step ' // trim(model%steps(s)%name) // ' and ' // rtoa(walls(wall_of(r))%friction) // &
+                    ' before; expected one friction per rigid surface in a material-point scene', err)
+               return
+            end if
+            walls(wall_of(r))%active(s) = .true.
+          end associate
+       end do
+    end do
+    call move_alloc(walls, model%mpm%walls)
+  end subroutine attach_surface_walls
+
+  !> In a material-point scene a node is a rigid body's reference node, or an error.
+  subroutine check_reference_nodes(deck, layout, model, err)
+    type(keyword_deck_t), intent(in) :: deck
+    type(scene_layout_t), intent(in) :: layout
+    type(model_t), intent(in) :: model
+    type(error_t), intent(inout) :: err
+    integer :: n, i
+
+    do n = 1, model%mesh%n_nodes
+       if (any(model%rigid_surfaces(1:model%n_rigid_surfaces)%ref_node == n)) cycle
+       do i = 1, deck%n_blocks
+          if (layout%step_of(i) == 0 .and. deck%blocks(i)%name == 'NODE') then
+             call deck%blocks(i)%fail('node ' // itoa(model%mesh%node_id(n)) // ' is no *RIGID BODY ' // &
+                  'reference node; expected only reference nodes of rigid surfaces in a material-point scene', err)
+             return
+          end if
+       end do
+    end do
+  end subroutine check_reference_nodes
 end module scene_mpm

@@ -15,7 +15,7 @@ module scene_reader
   use scene_discrete_rigid, only: rewrite_discrete_rigid
   use model, only: model_t
   use scene_layout, only: scene_layout_t, scan_layout
-  use scene_mesh, only: mesh_sources_t, build_mesh
+  use scene_mesh, only: mesh_sources_t, build_mesh, read_nodes
   use scene_geometry, only: check_element_geometry
   use scene_sets, only: build_sets
   use scene_materials, only: build_materials
@@ -25,7 +25,7 @@ module scene_reader
   use scene_surfaces, only: build_surfaces, build_rigid_bodies
   use scene_initial, only: build_initial_conditions
   use scene_steps, only: build_steps
-  use scene_mpm, only: is_mpm_scene, check_mpm_keywords, build_mpm
+  use scene_mpm, only: is_mpm_scene, check_mpm_keywords, build_mpm, mpm_has_nodes, attach_surface_walls
   implicit none
   private
 
@@ -83,18 +83,25 @@ contains
     call check_mpm_keywords(deck, grid_block, err)
     if (err%raised) return
     if (grid_block /= 0) then
-       allocate (model%element_surfaces(0), model%rigid_surfaces(0))
        call build_materials(deck, layout, model, user, err)
        if (err%raised) return
        call build_amplitudes(deck, model, err)
        if (err%raised) return
        call build_mpm(deck, layout, grid_block, model, err)
        if (err%raised) return
+       ! rigid surfaces as walls: their reference nodes (and sets), interactions, surfaces, bodies
+       if (mpm_has_nodes(deck)) call read_nodes(deck, layout, model, err)
+       if (.not. err%raised) call build_sets(deck, layout, model, err)
+       if (.not. err%raised) call build_interactions(deck, layout, model, err)
+       if (.not. err%raised) call build_surfaces(deck, layout, model, err)
+       if (.not. err%raised) call build_rigid_bodies(deck, layout, model, err)
+       if (err%raised) return
        ! predefined fields on the particles of a material (TEMPERATURE, FIELD only)
        call build_initial_conditions(deck, layout, model, err)
        if (err%raised) return
        call count_user_fields(model)
        call build_steps(deck, layout, model, err)
+       if (.not. err%raised) call attach_surface_walls(deck, layout, model, err)
        return
     end if
     call build_mesh(deck, layout, model, sources, err)

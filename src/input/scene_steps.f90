@@ -472,9 +472,19 @@ contains
          if (err%raised) return
          slave = field_name(dl, 1)
          master = field_name(dl, 2)
-         call require_element_surface(model, dl, slave, 'a rigid surface; expected the element ' // &
-              'surface first and the rigid surface second', ks, err)
-         if (err%raised) return
+         if (model%mpm%active) then
+            ! a material-point scene pairs its rigid surfaces with the particles: blank field 1
+            ks = 0
+            if (len(slave) > 0) then
+               call raise_error(dl%file, dl%line, 'surface ' // slave // ' in field 1 of a material-point ' // &
+                    'scene; expected a blank first field (the particles) and the rigid surface second', err)
+               return
+            end if
+         else
+            call require_element_surface(model, dl, slave, 'a rigid surface; expected the element ' // &
+                 'surface first and the rigid surface second', ks, err)
+            if (err%raised) return
+         end if
          km = find_rigid_surface(model, master)
          if (km == 0) then
             call raise_error(dl%file, dl%line, 'surface ' // master // ' is not a rigid surface; ' // &

@@ -32,6 +32,10 @@ module mpm_scene
   !> *MPM WALL: a rigid, fixed wall. 2D: the segment p0 -> p1, material on its left (as Abaqus
   !> TYPE=SEGMENTS); 3D: the plane through p0 with unit normal n into the material, limited to
   !> the box lo..hi when given. Active in the steps flagged in `active(step)`.
+  !> A wall with `surface` > 0 is instead a rigid surface of the model (*SURFACE, TYPE=SEGMENTS
+  !> or PLANE, paired with the particles by *CONTACT PAIR): its geometry (lines, arcs, plane)
+  !> and its motion (the *RIGID BODY reference node) come from model%rigid_surfaces(surface);
+  !> p0, p1, normal, reach and the box are not used.
   type, public :: mpm_wall_t
      character(len=wall_name_length) :: name = ''
      integer :: kind = wall_friction
@@ -43,6 +47,7 @@ module mpm_scene
      real(dp) :: lo(3) = 0, hi(3) = 0
      logical, allocatable :: active(:)      !< per step
      character(len=256) :: source = ''
+     integer :: surface = 0                 !< > 0: index into model%rigid_surfaces (a rigid-surface wall)
   end type mpm_wall_t
 
   !> *INFLOW of a step: keep the free surface at `level` (along the vertical axis) over the

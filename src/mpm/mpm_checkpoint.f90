@@ -57,6 +57,7 @@ module mpm_checkpoint
      real(dp), allocatable :: wall_force(:, :)        !< (3, n_walls)
      real(dp), allocatable :: wall_impulse(:, :)      !< (3, n_walls) since the last history row
      real(dp), allocatable :: wall_force_row(:, :)    !< (3, n_walls) of the last history row
+     real(dp), allocatable :: rigid_u(:, :)           !< (3, n_rigid_surfaces) reference node displacements
      !> increments of the running step: the FREQUENCY= output requests count them (the
      !> requests' next times are rebuilt from the step time, output_schedule)
      integer :: step_increment = 0
@@ -109,6 +110,8 @@ contains
     call checkpoint_put(ck, 'wall_force', sv%wall_force)
     call checkpoint_put(ck, 'wall_impulse', sv%wall_impulse)
     call checkpoint_put(ck, 'wall_force_row', sv%wall_force_row)
+    ! only scenes with rigid surfaces (checkpoints of the others stay as they were)
+    if (m%n_rigid_surfaces > 0) call checkpoint_put(ck, 'rigid_u', sv%rigid_u)
     do ib = 1, nblocks
        info(:, ib) = [blocks(ib)%count, blocks(ib)%material, size(blocks(ib)%state, 2), size(blocks(ib)%field, 2)]
     end do
@@ -175,6 +178,9 @@ contains
     call checkpoint_get(ck, 'wall_force', sv%wall_force, err)
     call checkpoint_get(ck, 'wall_impulse', sv%wall_impulse, err)
     call checkpoint_get(ck, 'wall_force_row', sv%wall_force_row, err)
+    allocate (sv%rigid_u(3, m%n_rigid_surfaces))
+    sv%rigid_u = 0
+    if (m%n_rigid_surfaces > 0) call checkpoint_get(ck, 'rigid_u', sv%rigid_u, err)
     if (err%raised) return
     call unpack_scalars(scalars, sv)
     sv%next_number = counters(1)

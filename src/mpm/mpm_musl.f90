@@ -10,12 +10,14 @@ module mpm_musl
   use error_report, only: raise_error
   use model, only: model_t
   use model_time_variation, only: variation_factor
+  use model_steps, only: bc_velocity
   use mpm_state, only: mpm_state_t, mpm_effects_t, fx_p2g, fx_grid, fx_g2p, fx_walls, max_over_ranks, det_f
   use mpm_grid, only: grid_sum_length, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t
   use mpm_shape, only: block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum
-  use mpm_walls, only: wall_project
+  use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
+  use mpm_setup, only: mark_wall_nodes
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
   use output_timer, only: timer_start, timer_stop
   use parallel_comm, only: comm_sum
@@ -23,7 +25,7 @@ module mpm_musl
   private
 
   public :: stable_increment, block_max_speed, step_gravity, musl_transfer
-  public :: stencil, p2g, grid_update, g2p, remap_velocity
+  public :: stencil, p2g, grid_update, g2p, remap_velocity, rigid_surface_motion
 
 contains
 
@@ -107,6 +109,7 @@ contains
     end do
     call timer_stop(fx%timers, fx%id(fx_p2g))
 
+    if (fx%active(fx_walls) .and. m%n_rigid_surfaces > 0) call surface_walls_at_new_time(m, st)
     call timer_start(fx%timers, fx%id(fx_grid))
     call grid_update(st, m%mpm%steps(s)%damping)
     call timer_stop(fx%timers, fx%id(fx_grid))
@@ -114,9 +117,26 @@ contains
        call timer_start(fx%timers, fx%id(fx_walls))
        do k = 1, size(m%mpm%walls)
           if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
-          call wall_project(m%mpm%walls(k), st%wall_nodes(k), st%nd, st%g%mass_own, st%g%active, st%g%v_new, &
-               st%dt, st%wall_force(:, k), st%e_walls)
+          associate (w => m%mpm%walls(k))
+            if (w%surface > 0) then
+               call surface_wall_project(st%wall_nodes(k), st%rigid_v(:, w%surface), w%friction, st%nd, &
+                    st%g%mass_own, st%g%active, st%g%v_new, st%dt, st%wall_force(:, k), st%e_walls)
+            else
+               call wall_project(w, st%wall_nodes(k), st%nd, st%g%mass_own, st%g%active, st%g%v_new, &
+                    st%dt, st%wall_force(:, k), st%e_walls)
+            end if
+          end associate
        end do
+       ! the work of the moving walls on the material, −F·v_w Δt (ALLWK; the grid and so the
+       ! forces are the same on every rank: counted on rank 0)
+       if (st%rank == 0) then
+          do k = 1, size(m%mpm%walls)
+             associate (w => m%mpm%walls(k))
+               if (w%surface > 0 .and. w%active(s)) st%w_external = st%w_external - &
+                    st%dt * dot_product(st%wall_force(:, k), st%rigid_v(:, w%surface))
+             end associate
+          end do
+       end if
        st%wall_impulse = st%wall_impulse + st%dt * st%wall_force
        st%impulse_time = st%impulse_time + st%dt
        call timer_stop(fx%timers, fx%id(fx_walls))
@@ -137,11 +157,82 @@ contains
        call timer_start(fx%timers, fx%id(fx_walls))
        do k = 1, size(m%mpm%walls)
           if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
-          call wall_project(m%mpm%walls(k), st%wall_nodes(k), st%nd, st%g%mass, st%g%active, st%g%v_new, st%dt)
+          associate (w => m%mpm%walls(k))
+            if (w%surface > 0) then
+               call surface_wall_project(st%wall_nodes(k), st%rigid_v(:, w%surface), w%friction, st%nd, &
+                    st%g%mass, st%g%active, st%g%v_new, st%dt)
+               ! particles behind it go back onto it here, at their x^n+1 (the fixed walls' guard
+               ! follows the stress update, mpm_flow)
+               do ib = 1, st%nblocks
+                  associate (b => st%blocks(ib))
+                    call surface_guard_block(m%rigid_surfaces(w%surface), st%rigid_u(:, w%surface), &
+                         st%rigid_v(:, w%surface), w%friction, b%count, st%nd, b%x(1:b%count, :), &
+                         b%v(1:b%count, :), st%n_guarded)
+                  end associate
+               end do
+            else
+               call wall_project(w, st%wall_nodes(k), st%nd, st%g%mass, st%g%active, st%g%v_new, st%dt)
+            end if
+          end associate
        end do
        call timer_stop(fx%timers, fx%id(fx_walls))
     end if
   end subroutine musl_transfer
+
+  !> The rigid surfaces at t_n+1: their reference nodes' velocity over the increment and
+  !> displacement (rigid_surface_motion), then the nodes of the active rigid-surface walls and
+  !> the wall-node marks local damping leaves alone.
+  subroutine surface_walls_at_new_time(m, st)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    integer :: k, s
+
+    s = st%step
+    call rigid_surface_motion(m, s, st%step_time, st%total_time, st%dt, st%rigid_u, st%rigid_v)
+    do k = 1, size(m%mpm%walls)
+       associate (w => m%mpm%walls(k))
+         if (w%surface == 0 .or. .not. w%active(s)) cycle
+         call surface_find_nodes(m%rigid_surfaces(w%surface), st%rigid_u(:, w%surface), st%g, st%wall_nodes(k))
+       end associate
+    end do
+    call mark_wall_nodes(m, st)
+  end subroutine surface_walls_at_new_time
+
+  !> Velocity v (over the increment t_n..t_n+1) and displacement u (advanced from t_n to t_n+1)
+  !> of every rigid surface's reference node, from the step's *BOUNDARY on it, as the element
+  !> driver moves its walls: a velocity condition gives value·A(t_n+½), a displacement condition
+  !> the velocity that reaches value·A(t_n+1) at t_n+1; a dof without one does not move (walls
+  !> are driven, not free bodies); a surface without a reference node is fixed.
+  subroutine rigid_surface_motion(m, s, step_time, total_time, dt, u, v)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: s
+    real(dp), intent(in) :: step_time, total_time, dt
+    real(dp), intent(inout) :: u(:, :), v(:, :)
+    integer :: r, ib, dof
+    real(dp) :: a_mid, a_new
+
+    v = 0
+    if (allocated(m%steps(s)%boundaries)) then
+       do ib = 1, size(m%steps(s)%boundaries)
+          associate (b => m%steps(s)%boundaries(ib))
+            a_mid = variation_factor(b%variation, m%amplitudes, step_time + 0.5_dp * dt, total_time + 0.5_dp * dt)
+            a_new = variation_factor(b%variation, m%amplitudes, step_time + dt, total_time + dt)
+            do r = 1, m%n_rigid_surfaces
+               if (m%rigid_surfaces(r)%ref_node == 0) cycle
+               if (.not. any(b%nodes == m%rigid_surfaces(r)%ref_node)) cycle
+               do dof = b%first_dof, min(b%last_dof, m%mpm%ndim)
+                  if (b%kind == bc_velocity) then
+                     v(dof, r) = b%value * a_mid
+                  else
+                     v(dof, r) = (b%value * a_new - u(dof, r)) / dt
+                  end if
+               end do
+            end do
+          end associate
+       end do
+    end if
+    u = u + dt * v
+  end subroutine rigid_surface_motion
 
   !> Sum the grid arrays over ranks: after P2G mass, momentum and force, after the remap momentum.
   subroutine reduce_grid(st, all_fields)

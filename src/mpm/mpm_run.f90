@@ -109,6 +109,7 @@ contains
     sv%wall_force = st%wall_force
     sv%wall_impulse = st%wall_impulse
     sv%wall_force_row = st%wall_force_row
+    sv%rigid_u = st%rigid_u
     sv%step_increment = st%step_increment
     sv%last_row_time = last_row_time
     sv%last_row_out = last_row_out
@@ -165,6 +166,7 @@ contains
     st%wall_force = sv%wall_force
     st%wall_impulse = sv%wall_impulse
     st%wall_force_row = sv%wall_force_row
+    st%rigid_u = sv%rigid_u
     st%step_increment = sv%step_increment
     last_row_time = sv%last_row_time
     last_row_out = sv%last_row_out

@@ -65,7 +65,16 @@ contains
       st%wall_impulse = 0
       st%wall_force_row = 0
       allocate (st%mirror(size(mpm%walls)), st%mirrored(size(mpm%walls)))
+      allocate (st%rigid_u(3, m%n_rigid_surfaces), st%rigid_v(3, m%n_rigid_surfaces))
+      st%rigid_u = 0
+      st%rigid_v = 0
       do k = 1, size(mpm%walls)
+         if (mpm%walls(k)%surface > 0) then
+            ! a rigid-surface wall finds its nodes every increment (it may move: mpm_musl)
+            allocate (st%wall_nodes(k)%nodes(0), st%wall_nodes(k)%normal(3, 0))
+            st%mirrored(k) = .false.
+            cycle
+         end if
          call wall_find_nodes(mpm%walls(k), st%g, st%wall_nodes(k))
          call mirror_plane_setup(mpm%walls(k), st%g, st%mirror(k), st%mirrored(k))
          ! a mirrored plane is no wall to the grid: its nodes and images are damped as the full

@@ -71,6 +71,9 @@ module mpm_state
      real(dp), allocatable :: wall_force_row(:, :)   !< the last history row's (mean) wall forces
      real(dp) :: impulse_time = 0
      logical, allocatable :: on_wall(:)              !< grid nodes of the walls active in this step
+     !> (3, model%n_rigid_surfaces) displacement of each rigid surface's reference node (t_n+1
+     !> once the walls of the increment are done) and its velocity over the increment
+     real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
      ! time
      integer :: step = 0, increment = 0
      integer :: step_increment = 0                   !< increments of the running step

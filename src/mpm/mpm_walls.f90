@@ -10,19 +10,31 @@
 !> the staircase of nodes just behind it, with the exact normal (no staircase friction).
 !> Particles that end an increment behind a wall (the wall's stencil is one cell wide) are put
 !> back onto it: `guard_particles`; the count is reported.
+!>
+!> Rigid-surface walls (mpm_wall_t%surface > 0: *SURFACE, TYPE=SEGMENTS/PLANE paired with the
+!> particles) are the element contact's geometry (contact_geometry's closest point: chains of
+!> lines and arcs, planes) and may move with their reference node. Their nodes are found again
+!> every increment (`surface_find_nodes`: gap <= 0 against the surface at t_n+1, each with the
+!> surface's normal there); the projection splits the velocity relative to the wall,
+!> v − v_w, so a node ends with at least the wall's normal velocity (`surface_node_velocity`).
 module mpm_walls
   use base_kinds, only: dp
   use mpm_scene, only: mpm_wall_t, wall_symmetry
   use mpm_grid, only: grid_t
+  use model_surfaces, only: rigid_surface_t
+  use contact_geometry, only: surface_closest_point
   implicit none
   private
 
-  !> A wall with the grid nodes it constrains.
+  !> A wall with the grid nodes it constrains (and, for a rigid-surface wall, the surface's unit
+  !> normal into the material at each of them, normal(3, size(nodes))).
   type, public :: wall_nodes_t
      integer, allocatable :: nodes(:)
+     real(dp), allocatable :: normal(:, :)
   end type wall_nodes_t
 
   public :: wall_find_nodes, wall_project, wall_contains, wall_distance, wall_slide_velocity, wall_rows_behind
+  public :: surface_find_nodes, surface_wall_project, surface_node_velocity, surface_guard_block
 
   !> A node within this fraction of the cell from a wall is on it. Scene coordinates come with
   !> ~9 digits, and a cell written with 6 (0.0357143 for 0.125/3.5) put the hopper's axis node
@@ -201,4 +213,122 @@ contains
     if (tn > 0) scale = max(0.0_dp, 1 - mu * abs(vn) / tn)
     vnew = vt * scale
   end subroutine coulomb_slide
+
+  ! ------------------------------------------------------------------------------------------
+  ! Rigid-surface walls (the element contact's geometry; moving with their reference node)
+  ! ------------------------------------------------------------------------------------------
+
+  !> The grid nodes on or behind the rigid surface `surf` translated by `offset` (its position
+  !> at t_n+1): gap <= node_on_wall_tolerance·h, with the surface's unit normal at each. Every
+  !> node with mass (called after P2G, before the grid update decides which are active: the list
+  !> also marks the nodes local damping leaves alone); a node without mass is never active. Why
+  !> every increment: a moving wall sweeps over node lines; a fixed one gets the same list.
+  subroutine surface_find_nodes(surf, offset, g, wn)
+    type(rigid_surface_t), intent(in) :: surf
+    real(dp), intent(in) :: offset(3)
+    type(grid_t), intent(in) :: g
+    type(wall_nodes_t), intent(inout) :: wn
+    integer :: i, n, nd
+    integer, allocatable :: list(:)
+    real(dp), allocatable :: nrm(:, :)
+    real(dp) :: x(3), gap, normal(3), cp(3), tol
+
+    nd = g%ndim
+    tol = node_on_wall_tolerance * g%h
+    allocate (list(g%nn), nrm(3, g%nn))
+    n = 0
+    do i = 1, g%nn
+       if (.not. g%mass(i) > 0) cycle
+       x = g%position(i)
+       normal = 0
+       call surface_closest_point(surf, offset(1:nd), x(1:nd), gap, normal(1:nd), cp(1:nd))
+       if (gap > tol) cycle
+       n = n + 1
+       list(n) = i
+       nrm(:, n) = normal
+    end do
+    wn%nodes = list(1:n)
+    wn%normal = nrm(:, 1:n)
+  end subroutine surface_find_nodes
+
+  !> A velocity v against a wall with unit normal n (into the material) moving with vw: if the
+  !> velocity relative to the wall approaches it, its normal part goes and μ times that is taken
+  !> from its tangential part (Coulomb: stick when that exceeds it), then the wall's velocity is
+  !> added back (hit); otherwise v is unchanged. tn: |relative tangential velocity|, scale: the
+  !> fraction of it left (for the friction dissipation); 0 and 1 when nothing happens.
+  pure subroutine surface_node_velocity(n, vw, mu, v, vnew, tn, scale, hit)
+    real(dp), intent(in) :: n(3), vw(3), mu, v(3)
+    real(dp), intent(out) :: vnew(3), tn, scale
+    logical, intent(out) :: hit
+    real(dp) :: vrel(3), vn, vt(3)
+
+    vrel = v - vw
+    vn = dot_product(vrel, n)
+    tn = 0
+    scale = 1
+    hit = vn < 0
+    if (.not. hit) then
+       vnew = v
+       return
+    end if
+    call coulomb_slide(mu, vrel, vn, n, vt, tn, scale)
+    vnew = vw + vt
+  end subroutine surface_node_velocity
+
+  !> Project the velocities of a rigid-surface wall's nodes (wn from surface_find_nodes) for a
+  !> wall moving with vw, friction mu; with `force`, add the force of the material on the wall,
+  !> −Σ m Δv / Δt (the momentum the wall takes from the nodes), and into `dissipated` the
+  !> kinetic energy friction takes out of the relative tangential motion.
+  subroutine surface_wall_project(wn, vw, mu, ndim, mass, active, v, dt, force, dissipated)
+    type(wall_nodes_t), intent(in) :: wn
+    real(dp), intent(in) :: vw(3), mu
+    integer, intent(in) :: ndim
+    real(dp), intent(in) :: mass(:)
+    logical, intent(in) :: active(:)
+    real(dp), intent(inout) :: v(:, :)
+    real(dp), intent(in) :: dt
+    real(dp), intent(inout), optional :: force(3)
+    real(dp), intent(inout), optional :: dissipated
+    integer :: k, i
+    real(dp) :: vi(3), vnew(3), tn, scale
+    logical :: hit
+
+    do k = 1, size(wn%nodes)
+       i = wn%nodes(k)
+       if (.not. active(i)) cycle
+       vi = 0
+       vi(1:ndim) = v(:, i)
+       call surface_node_velocity(wn%normal(:, k), vw, mu, vi, vnew, tn, scale, hit)
+       if (.not. hit) cycle
+       if (present(force)) force = force - mass(i) * (vnew - vi) / dt
+       if (present(dissipated)) dissipated = dissipated + 0.5_dp * mass(i) * tn * tn * (1 - scale * scale)
+       v(:, i) = vnew(1:ndim)
+    end do
+  end subroutine surface_wall_project
+
+  !> Particles of a block (x(nb, nd), v(nb, nd)) behind the rigid surface at `offset`: put back
+  !> onto its closest point, with the nodes' rule on their velocity relative to the wall (the
+  !> approaching normal part goes, Coulomb on the rest). n_guarded counts them.
+  subroutine surface_guard_block(surf, offset, vw, mu, nb, nd, x, v, n_guarded)
+    type(rigid_surface_t), intent(in) :: surf
+    real(dp), intent(in) :: offset(3), vw(3), mu
+    integer, intent(in) :: nb, nd
+    real(dp), intent(inout) :: x(nb, nd), v(nb, nd)
+    integer, intent(inout) :: n_guarded
+    integer :: p
+    real(dp) :: gap, normal(3), cp(3), vi(3), vnew(3), tn, scale
+    logical :: hit
+
+    do p = 1, nb
+       normal = 0
+       call surface_closest_point(surf, offset(1:nd), x(p, :), gap, normal(1:nd), cp(1:nd))
+       if (.not. gap < 0) cycle
+       x(p, :) = cp(1:nd)
+       vi = 0
+       vi(1:nd) = v(p, :)
+       call surface_node_velocity(normal, vw, mu, vi, vnew, tn, scale, hit)
+       v(p, :) = vnew(1:nd)
+       n_guarded = n_guarded + 1
+    end do
+  end subroutine surface_guard_block
 end module mpm_walls

@@ -19,6 +19,18 @@ kinds:
              no particle is put back onto the plane (GUARDED = 0): src/mpm/mpm_mirror.f90
   mass       hopper with outlet, outflow and inflow: initial + in - out = in domain exactly
              (particle counts exact, masses to round-off), and both flows present
+  plate      a rigid plate (a *SURFACE, TYPE=SEGMENTS on a *RIGID BODY node moved by *BOUNDARY) pushed
+             into an elastic column in a frictionless box (plate_oedometer_2d.inp): its reaction
+             against the oedometric force balance F = M W |ln(1 - u/H)|, M = E(1-nu)/((1+nu)(1-2nu)),
+             within 2 % at the end and along the push (rows past 40 % of the push, against the
+             mean of F over the row); floor = plate (static balance, 1e-3), side walls
+             K0 F H / W (1 %), the plate's work in ALLWK balances ALLIE (ETOTAL < 1 % of ALLWK),
+             no particle put back; stopped mid-push and restarted: identical history and frames
+  bowl       particles settled in a bowl of two fixed CIRCL surfaces (bowl_arcs_2d.inp): the two
+             arcs carry the weight (1e-3), each the horizontal thrust of a fluid at rest on its
+             vertical projection rho g L^2 / 2 (3 %: the arc's normals), no particle outside the
+             circle but every 5 deg sector's outermost within a particle spacing of it (on the arcs,
+             not their chords), the pressure at the bottom within 10 % of rho g times its depth
   restart    on --ranks N: a run uninterrupted, one stopped with --stop-after K (in the
              discharge, after outflow and inflow began) and continued with --restart: every
              particle and grid frame (datasets and attributes), the XDMF files and the history
@@ -415,9 +427,94 @@ def restart(args):
             [f"saved.rst.", f"written by a run on {n} ranks, this run has {other}"])
 
 
+def plate(args):
+    base, out, hist = run(args.bulkflow, args.scene, args.workdir)
+    check_report(out, ["walls"], ["gravity", "damping", "outflow", "inflow"])
+    e, nu, width, height, push, ramp = 1.0e7, 0.3, 0.2, 0.5, 0.0025, 0.1
+    modulus = e * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+
+    def smooth(t):   # *AMPLITUDE, DEFINITION=SMOOTH STEP from (0, 0) to (ramp, 1)
+        xi = np.clip(t / ramp, 0.0, 1.0)
+        return xi ** 3 * (10 - 15 * xi + 6 * xi ** 2)
+
+    def force(t):
+        return modulus * width * np.abs(np.log(1 - push * smooth(t) / height))
+
+    t, f = hist["time"], hist["WALLF2_PLATE"]
+    final = force(ramp)
+    err = f[-1] / final - 1
+    check(abs(err) < 0.02, f"plate reaction {f[-1]:.1f} N/m vs M W |ln(1 - u/H)| = {final:.1f} N/m, "
+          f"error {err:+.2e}")
+    worst = 0.0
+    for k in range(1, len(t)):
+        if t[k - 1] < 0.4 * ramp:
+            continue
+        ts = np.linspace(t[k - 1], t[k], 201)
+        worst = max(worst, abs(f[k] - force(ts).mean()) / final)
+    check(worst < 0.02, f"plate reaction along the push: max |F - M W |ln(1 - u/H)|| = {worst:.2e} of the final")
+    floor = hist["WALLF2_FLOOR"][-1]
+    check(abs(floor + f[-1]) < 1e-3 * f[-1], f"floor reaction {floor:.1f} N/m balances the plate's")
+    k0 = nu / (1 - nu)
+    side = k0 * f[-1] / width * height
+    for w in ("LEFT", "RIGHT"):
+        fs = abs(hist["WALLF1_" + w][-1])
+        check(abs(fs / side - 1) < 0.01, f"side wall {w}: {fs:.1f} N/m vs K0 F H / W = {side:.1f} N/m")
+    work = hist["ALLWK"][-1]
+    check(abs(work - hist["ALLIE"][-1]) < 0.01 * work and abs(hist["ETOTAL"][-1]) < 0.01 * work,
+          f"plate work ALLWK = {work:.4f} J/m, ALLIE = {hist['ALLIE'][-1]:.4f}, ETOTAL = {hist['ETOTAL'][-1]:.2e}")
+    check(hist["GUARDED"][-1] == 0, "no particle put back behind a wall")
+    mass_balance(hist)
+    # stopped during the push (the reference node's displacement is in the checkpoint) and
+    # restarted: the same history and frames bit for bit
+    part = args.workdir / "restarted"
+    for extra in (["--stop-after", "700"], ["--restart"]):
+        r = subprocess.run([args.bulkflow, args.scene, "--output", str(part), "--quiet"] + extra,
+                           capture_output=True, text=True)
+        check(r.returncode == 0, f"run {' '.join(extra)} exits 0")
+    same_rows = Path(f"{part}_history.csv").read_bytes() == Path(f"{base}_history.csv").read_bytes()
+    bad, n = same_h5(f"{part}.h5", f"{base}.h5")
+    check(same_rows and not bad, f"stopped at increment 700 and restarted: history and {n} HDF5 objects identical")
+
+
+def bowl(args):
+    base, out, hist = run(args.bulkflow, args.scene, args.workdir)
+    check_report(out, ["walls", "gravity", "damping"], ["outflow", "inflow"])
+    rho, grav, radius, ppc = 1600.0, 9.81, 0.5, 2
+    weight = hist["MASS"][-1] * grav
+    fy = hist["WALLF2_LEFT"][-1] + hist["WALLF2_RIGHT"][-1]
+    check(abs(fy + weight) < 1e-3 * weight, f"the arcs carry the weight: {-fy:.2f} vs M g = {weight:.2f} N/m")
+    g = last_frame(base)
+    x, s = g["coordinates"][:], g["S"][:]
+    h = float(h5py.File(str(base) + ".h5", "r")["grid"].attrs["h"][0])
+    level = x[:, 1].max() + h / (2 * ppc)          # the free surface: top particles' upper edge
+    thrust = rho * grav * level ** 2 / 2
+    for w, sign in (("LEFT", -1), ("RIGHT", 1)):
+        fx = sign * hist["WALLF1_" + w][-1]
+        check(abs(fx / thrust - 1) < 0.03, f"arc {w}: horizontal thrust {fx:.2f} N/m vs rho g L^2/2 = "
+              f"{thrust:.2f} (L = {level:.4f} m)")
+    r = np.hypot(x[:, 0], x[:, 1] - radius)
+    check(r.max() <= radius, f"no particle outside the circle: max r = {r.max():.5f} m (R = {radius})")
+    # the material lies on the arcs, not on their chords (which pass up to R(1 - cos 40 deg) = 0.12 m
+    # inside): in every 5 deg sector below the free surface the outermost particle is within one
+    # particle spacing of the circle
+    phi = np.degrees(np.arctan2(x[:, 0], radius - x[:, 1]))
+    top = math.degrees(math.acos(1 - (level - h) / radius))
+    gaps = [radius - r[(phi >= a) & (phi < a + 5)].max() for a in np.arange(-top, top - 5, 5.0)]
+    check(max(gaps) < h / ppc, f"the material rests on the arcs: largest gap to the circle {max(gaps):.4f} m "
+          f"in {len(gaps)} sectors (spacing {h / ppc} m)")
+    check(hist["GUARDED"][-1] == 0, "no particle put back behind an arc")
+    m = (np.abs(x[:, 0]) < 2 * h) & (x[:, 1] < 2 * h)
+    pressure = -(s[m, 0] + s[m, 1] + s[m, 2]).mean() / 3
+    expected = rho * grav * (level - x[m, 1].mean())
+    check(abs(pressure / expected - 1) < 0.10, f"pressure at the bottom {pressure:.0f} Pa vs rho g depth = "
+          f"{expected:.0f} Pa")
+    check(hist["ALLKE"][-1] < 1e-4 * hist["ALLIE"][-1], "settled (ALLKE << ALLIE)")
+    mass_balance(hist)
+
+
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("kind", choices=["column", "incline", "heap", "mirror", "mass", "mpi", "restart"])
+    p.add_argument("kind", choices=["column", "incline", "heap", "mirror", "mass", "mpi", "restart", "plate", "bowl"])
     p.add_argument("--mpiexec", default="mpirun")
     p.add_argument("--ranks", type=int, default=1, help="restart: number of ranks")
     p.add_argument("--stop-after", type=int, default=0, help="restart: increment to stop after")
