@@ -277,8 +277,9 @@ contains
 
   !> Project the velocities of a rigid-surface wall's nodes (wn from surface_find_nodes) for a
   !> wall moving with vw, friction mu; with `force`, add the force of the material on the wall,
-  !> −Σ m Δv / Δt (the momentum the wall takes from the nodes), and into `dissipated` the
-  !> kinetic energy friction takes out of the relative tangential motion.
+  !> −Σ m Δv / Δt (the momentum the wall takes from the nodes), and into `dissipated` the work
+  !> of friction on the relative slip, m (|v_t| − |v_t,new|) |v_t,new| per node (wall_project's
+  !> rule: a node held at rest books nothing).
   subroutine surface_wall_project(wn, vw, mu, ndim, mass, active, v, dt, force, dissipated)
     type(wall_nodes_t), intent(in) :: wn
     real(dp), intent(in) :: vw(3), mu
@@ -301,7 +302,7 @@ contains
        call surface_node_velocity(wn%normal(:, k), vw, mu, vi, vnew, tn, scale, hit)
        if (.not. hit) cycle
        if (present(force)) force = force - mass(i) * (vnew - vi) / dt
-       if (present(dissipated)) dissipated = dissipated + 0.5_dp * mass(i) * tn * tn * (1 - scale * scale)
+       if (present(dissipated)) dissipated = dissipated + mass(i) * tn * tn * scale * (1 - scale)
        v(:, i) = vnew(1:ndim)
     end do
   end subroutine surface_wall_project
