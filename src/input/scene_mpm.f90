@@ -617,7 +617,7 @@ contains
     allocate (wall_of(model%n_rigid_surfaces))
     wall_of = 0
     n0 = size(model%mpm%walls)
-    walls = model%mpm%walls
+    allocate (walls, source=model%mpm%walls)
     do s = 1, model%n_steps
        if (.not. allocated(model%steps(s)%contact_pairs)) cycle
        do j = 1, size(model%steps(s)%contact_pairs)
