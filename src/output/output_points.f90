@@ -247,10 +247,12 @@ contains
     integer(hid_t) :: dset
     integer :: hdferr
 
+    ! allocate(source=): gfortran 12 at -O0 takes an assignment into an unallocated array for
+    ! a read of its bounds (maybe-uninitialized under -Werror)
     if (ncomp == 1) then
-       dims = int(w%grid_mesh%grid_n, hsize_t)
+       allocate (dims, source=int(w%grid_mesh%grid_n, hsize_t))
     else
-       dims = [int(ncomp, hsize_t), int(w%grid_mesh%grid_n, hsize_t)]
+       allocate (dims, source=[int(ncomp, hsize_t), int(w%grid_mesh%grid_n, hsize_t)])
     end if
     call create_shaped_dataset(w%grid, name, H5T_IEEE_F64LE, dims, dset)
     call write_whole_real(w%xfer, dset, values, w%rank == 0)
