@@ -53,6 +53,8 @@ contains
     call checkpoint_put(ck, 'f_int', solver%f_int)
     call checkpoint_put(ck, 'f_ext', solver%f_ext)
     call checkpoint_put(ck, 'reaction', solver%reaction)
+    ! the walls' forces of this increment: a step's first history row reports them
+    call checkpoint_put(ck, 'wall_force', solver%wall_force)
     call checkpoint_put(ck, 'rigid_u', rigid_array(solver, .true.))
     call checkpoint_put(ck, 'rigid_v', rigid_array(solver, .false.))
     call checkpoint_put(ck, 'scalars', [solver%e_viscous, solver%e_artificial, solver%e_friction, &
@@ -132,6 +134,7 @@ contains
     call checkpoint_get(ck, 'f_int', solver%f_int, err)
     call checkpoint_get(ck, 'f_ext', solver%f_ext, err)
     call checkpoint_get(ck, 'reaction', solver%reaction, err)
+    call checkpoint_get(ck, 'wall_force', solver%wall_force, err)
     allocate(rigid_u(3, size(solver%rigid)), rigid_v(3, size(solver%rigid)))
     call checkpoint_get(ck, 'rigid_u', rigid_u, err)
     call checkpoint_get(ck, 'rigid_v', rigid_v, err)
