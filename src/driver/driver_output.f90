@@ -16,6 +16,7 @@ module driver_output
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
   use fem_corotation, only: stored_to_global
   use driver_stop_condition, only: count_stop_columns, add_stop_columns, stop_column_values
+  use driver_temperature, only: frame_temperatures
   implicit none
   private
 
@@ -265,6 +266,10 @@ contains
        allocate(values(n, 1))
        values = 1
        call field_writer_element_field(out%fields, 'STATUS', solver%part%elem_global, values)
+    case ('TEMP')
+       allocate(values(n, 1))
+       call frame_temperatures(m, solver, values(:, 1))
+       call field_writer_element_field(out%fields, 'TEMP', solver%part%elem_global, values)
     end select
   contains
 
