@@ -7,7 +7,8 @@
 !> centroid value of the bilinear/trilinear interpolation), written as base + Σ_j coef_j a_j(t)
 !> with base the initial temperatures of the nodes no entry names; the coefficients are built
 !> once per step and block. Particles: model_particle_fields. The element output TEMP
-!> (frame_temperatures) is the same mean at the frame's time, for every material.
+!> (frame_temperatures) is the same mean at the frame's time, for every material; the node
+!> output NT (frame_node_temperatures) the node temperatures it averages.
 module driver_temperature
   use base_kinds, only: dp
   use model, only: model_t
@@ -16,7 +17,7 @@ module driver_temperature
   implicit none
   private
 
-  public :: element_temperatures, frame_temperatures
+  public :: element_temperatures, frame_temperatures, frame_node_temperatures
 
 contains
 
@@ -40,27 +41,16 @@ contains
 
   !> The element output TEMP: temp(n_local_elems) in the solver's element order, the mean of
   !> each element's node temperatures at the solver's current time (the end of the last
-  !> increment: what a user's VUMAT received as tempNew). Node temperatures are the last entry
-  !> of the step naming the node (value × amplitude), else its initial temperature. Built from
-  !> the model at every frame, so built-in materials (whose blocks keep no temperature) write it.
+  !> increment: what a user's VUMAT received as tempNew). Built from the model at every frame,
+  !> so built-in materials (whose blocks keep no temperature) write it too.
   subroutine frame_temperatures(m, solver, temp)
     type(model_t), intent(in) :: m
     type(solver_t), intent(in) :: solver
     real(dp), intent(out) :: temp(:)
     real(dp), allocatable :: node_temp(:)
-    integer :: j, e, a
+    integer :: e, a
 
-    call initial_node_temperatures(m, node_temp)
-    if (solver%step >= 1 .and. solver%step <= m%n_steps) then
-       if (allocated(m%steps(solver%step)%temperatures)) then
-          do j = 1, size(m%steps(solver%step)%temperatures)
-             associate (t => m%steps(solver%step)%temperatures(j))
-               node_temp(t%nodes) = t%value * variation_factor(t%variation, m%amplitudes, solver%step_time, &
-                    solver%total_time)
-             end associate
-          end do
-       end if
-    end if
+    call frame_node_temperatures(m, solver, node_temp)
     do e = 1, solver%part%n_local_elems
        associate (g => solver%part%elem_global(e))
          temp(e) = 0
@@ -71,6 +61,26 @@ contains
        end associate
     end do
   end subroutine frame_temperatures
+
+  !> The node output NT: node_temp(n_nodes) of every node of the mesh at the solver's current
+  !> time, the last entry of the step naming the node (value × amplitude), else the node's
+  !> initial temperature.
+  subroutine frame_node_temperatures(m, solver, node_temp)
+    type(model_t), intent(in) :: m
+    type(solver_t), intent(in) :: solver
+    real(dp), allocatable, intent(out) :: node_temp(:)
+    integer :: j
+
+    call initial_node_temperatures(m, node_temp)
+    if (solver%step < 1 .or. solver%step > m%n_steps) return
+    if (.not. allocated(m%steps(solver%step)%temperatures)) return
+    do j = 1, size(m%steps(solver%step)%temperatures)
+       associate (t => m%steps(solver%step)%temperatures(j))
+         node_temp(t%nodes) = t%value * variation_factor(t%variation, m%amplitudes, solver%step_time, &
+              solver%total_time)
+       end associate
+    end do
+  end subroutine frame_node_temperatures
 
   !> Every node's *INITIAL CONDITIONS, TYPE=TEMPERATURE value (entries naming a node add up, as
   !> in driver_setup's element means; 0 where none names it).

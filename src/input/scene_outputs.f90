@@ -243,7 +243,7 @@ contains
     select case (blk%name)
     case ('NODE OUTPUT')
        if (os%current_is_field) then
-          call node_field_output(blk, os, err)
+          call node_field_output(blk, model%mpm%active, os, err)
        else
           call node_history_output(blk, model, os, err)
        end if
@@ -254,15 +254,17 @@ contains
     end select
   end subroutine read_output_option
 
-  subroutine node_field_output(blk, os, err)
+  !> particles: a material-point scene (no node fields are written; NT is refused there).
+  subroutine node_field_output(blk, particles, os, err)
     type(keyword_block_t), intent(in) :: blk
+    logical, intent(in) :: particles
     type(output_state_t), intent(inout) :: os
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: name
     integer :: il, k
 
     call blk%check_params([character(len=8) ::], err)
-    if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'variable names U, V, A, RF', err)
+    if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'variable names U, V, A, RF, NT', err)
     if (err%raised) return
     do il = 1, blk%n_lines
        do k = 1, blk%lines(il)%n_fields()
@@ -271,9 +273,17 @@ contains
           select case (name)
           case ('U', 'V', 'A', 'RF')
              call add_name(os%field(os%n_field)%node_variables, name)
+          case ('NT')
+             if (particles) then
+                call raise_error(blk%lines(il)%file, blk%lines(il)%line, 'node field output variable NT ' // &
+                     'is written for the nodes of element scenes; expected TEMP in *ELEMENT OUTPUT for ' // &
+                     'the particles of a material-point scene', err)
+                return
+             end if
+             call add_name(os%field(os%n_field)%node_variables, name)
           case default
              call raise_error(blk%lines(il)%file, blk%lines(il)%line, 'node field output variable ' // &
-                  name // ' is not available; expected U, V, A or RF', err)
+                  name // ' is not available; expected U, V, A, RF or NT', err)
              return
           end select
        end do

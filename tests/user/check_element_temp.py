@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
-"""TEMP as an element field output (issue 15): every frame's TEMP dataset holds each element's
-temperature at the frame's time, the mean of its nodes' temperatures.
+"""TEMP as an element field output and NT as a node field output (issue 15): every frame's TEMP
+dataset holds each element's temperature at the frame's time, the mean of its nodes'
+temperatures, and NT those node temperatures (as Abaqus names them: NT for nodes, TEMP for
+elements).
 
     check_element_temp.py CASE --bulkflow BIN --work DIR [--mpiexec MPIEXEC [--mpiexec-flag F]...]
 
@@ -11,13 +13,14 @@ Cases
                  the first column have four such nodes, those of the second two, the rest none;
                  step 2 (0.2 s): *TEMPERATURE, OP=NEW, all nodes 50. TEMP of element e at a frame
                  of step 1 is (k_e 100 a(t) + (4 - k_e) 20) / 4 (k_e its nodes with x <= 1), 50 in
-                 step 2; checked to 1e-12 in every frame, with the frame count and the XDMF.
+                 step 2; NT 100 a(t) on those nodes, 20 on the others, 50 in step 2; checked to
+                 1e-12 in every frame, with the frame count and the XDMF.
   builtin_c3d8r  the same on 4 x 2 x 1 C3D8R (k_e of 8 nodes).
   builtin_mpi    builtin_cpe4r on 2 ranks (each rank writes its own elements).
   user_probe     the probe VUMAT (probe_vumat.f, --user) in 12 x 12 CPE4R under the temperature
                  ramp T0 + 400 t it checks as tempOld/tempNew on every call: TEMP = T0 + 400 t at
                  every frame, the tempNew of the increment that ended there.
-  no_request     builtin_cpe4r without TEMP in the request: no TEMP dataset, none in the XDMF.
+  no_request     builtin_cpe4r without TEMP and NT in the request: no dataset, none in the XDMF.
 """
 from __future__ import annotations
 
@@ -45,8 +48,9 @@ def ramp(t: float) -> float:
     return min(t / RAMP_END, 1.0)
 
 
-def grid_scene(ndim: int, with_temp: bool = True) -> tuple[str, np.ndarray]:
-    """The scene text and, per element (in file order), how many of its nodes have x <= 1."""
+def grid_scene(ndim: int, with_temp: bool = True) -> tuple[str, np.ndarray, np.ndarray]:
+    """The scene text, per element (in file order) how many of its nodes have x <= 1, and those
+    nodes' labels."""
     n = (4, 2) if ndim == 2 else (4, 2, 1)
     grids = [np.arange(k + 1, dtype=float) for k in n]
     coords = np.array(np.meshgrid(*grids, indexing='ij')).reshape(ndim, -1).T
@@ -77,16 +81,16 @@ def grid_scene(ndim: int, with_temp: bool = True) -> tuple[str, np.ndarray]:
               '*INITIAL CONDITIONS, TYPE=TEMPERATURE', f'ALL, {T_INITIAL!r}',
               '*AMPLITUDE, NAME=RAMP', f'0., 0., {RAMP_END!r}, 1.',
               '*BOUNDARY', f'ALL, {dofs}']
-    request = 'S, TEMP' if with_temp else 'S'
+    request = ['*ELEMENT OUTPUT', 'S, TEMP', '*NODE OUTPUT', 'U, NT'] if with_temp else ['*ELEMENT OUTPUT', 'S']
     lines += ['*STEP, NAME=HEAT', '*DYNAMIC, EXPLICIT', ', 0.5',
               '*TEMPERATURE, AMPLITUDE=RAMP', f'HOT, {T_HOT!r}',
-              '*OUTPUT, FIELD, NUMBER INTERVAL=5', '*ELEMENT OUTPUT', request,
+              '*OUTPUT, FIELD, NUMBER INTERVAL=5', *request,
               '*OUTPUT, HISTORY, NUMBER INTERVAL=5', '*ENERGY OUTPUT', '*END STEP',
               '*STEP, NAME=HOLD', '*DYNAMIC, EXPLICIT', ', 0.2',
               '*TEMPERATURE, OP=NEW', f'ALL, {T_STEP2!r}',
-              '*OUTPUT, FIELD, NUMBER INTERVAL=2', '*ELEMENT OUTPUT', request,
+              '*OUTPUT, FIELD, NUMBER INTERVAL=2', *request,
               '*OUTPUT, HISTORY, NUMBER INTERVAL=2', '*ENERGY OUTPUT', '*END STEP']
-    return '\n'.join(lines) + '\n', hot_count
+    return '\n'.join(lines) + '\n', hot_count, np.array(hot_nodes)
 
 
 def run(cmd: list[str], cwd: Path) -> None:
@@ -96,10 +100,13 @@ def run(cmd: list[str], cwd: Path) -> None:
         raise Failed(f'exit {r.returncode}: {" ".join(cmd)}\n{r.stdout[-2000:]}{r.stderr[-2000:]}')
 
 
-def frames_of(h5: Path) -> list[tuple[int, float, dict]]:
-    """(step, step time, datasets) of every element frame, and the element ids in dataset order."""
+def frames_of(h5: Path, nodes: bool = False):
+    """The element ids (with nodes: also the node ids) in dataset order, and (step, step time,
+    datasets) of every frame."""
     with h5py.File(h5, 'r') as f:
         ids = f['mesh']['element_id'][()]
+        if nodes:
+            ids = (ids, f['mesh']['node_id'][()])
         out = []
         for k in sorted(f['frames']):
             g = f['frames'][k]
@@ -109,7 +116,7 @@ def frames_of(h5: Path) -> list[tuple[int, float, dict]]:
 
 
 def check_builtin(a, ndim: int, ranks: int = 1) -> None:
-    text, hot_count = grid_scene(ndim)
+    text, hot_count, hot_nodes = grid_scene(ndim)
     a.work.mkdir(parents=True, exist_ok=True)
     scene = a.work / 'temp.inp'
     scene.write_text(text)
@@ -119,7 +126,8 @@ def check_builtin(a, ndim: int, ranks: int = 1) -> None:
             raise Failed('this case needs --mpiexec')
         cmd = [a.mpiexec, *a.mpiexec_flag, '-n', str(ranks), *cmd]
     run(cmd, a.work)
-    ids, frames = frames_of(a.work / 'temp.h5')
+    (ids, node_ids), frames = frames_of(a.work / 'temp.h5', nodes=True)
+    hot = np.isin(node_ids, hot_nodes)
     # 0.5 s in 5 intervals and 0.2 s in 2, each with its start frame: 6 + 2 (the step start of
     # the second is the end of the first, not written twice)
     if len(frames) < 8:
@@ -137,17 +145,23 @@ def check_builtin(a, ndim: int, ranks: int = 1) -> None:
             want = (k * T_HOT * ramp(t) + (nen - k) * T_INITIAL) / nen
         else:
             want = np.full(len(ids), T_STEP2)
-        err = float(np.max(np.abs(temp - want)))
+        if 'NT' not in data or np.ravel(data['NT']).shape != (len(node_ids),):
+            raise Failed(f'frame at step {step}, t = {t}: no NT of {len(node_ids)} nodes')
+        nt = np.ravel(data['NT'])
+        want_nt = np.where(hot, T_HOT * ramp(t), T_INITIAL) if step == 1 else np.full(len(node_ids), T_STEP2)
+        err = max(float(np.max(np.abs(temp - want))), float(np.max(np.abs(nt - want_nt))))
         worst = max(worst, err)
         print(f'  step {step}, t = {t:.4f}: TEMP {np.array2string(temp[:4], precision=6)}..., '
-              f'max |TEMP - closed form| = {err:.2e}')
+              f'max |TEMP, NT - closed form| = {err:.2e}')
         if err > 1e-12 * max(1.0, float(np.max(np.abs(want)))):
             raise Failed(f'step {step}, t = {t}: TEMP differs from the closed form by {err:.3e}')
     xmf = (a.work / 'temp.xmf').read_text()
-    if xmf.count('Name="TEMP"') != len(frames):
-        raise Failed(f'temp.xmf names TEMP {xmf.count(chr(34) + "TEMP")} times for {len(frames)} frames')
-    print(f'  {len(frames)} frames, worst |TEMP - closed form| = {worst:.2e} (limit 1e-12 relative); '
-          f'XDMF shows TEMP in every frame')
+    for name in ('TEMP', 'NT'):
+        if xmf.count(f'Name="{name}"') != len(frames):
+            raise Failed(f'temp.xmf names {name} {xmf.count(f"Name={chr(34)}{name}{chr(34)}")} times for '
+                         f'{len(frames)} frames')
+    print(f'  {len(frames)} frames, worst |TEMP, NT - closed form| = {worst:.2e} (limit 1e-12 relative); '
+          f'XDMF shows TEMP and NT in every frame')
 
 
 def check_user_probe(a) -> None:
@@ -176,15 +190,16 @@ def check_user_probe(a) -> None:
 
 
 def check_no_request(a) -> None:
-    text, _ = grid_scene(2, with_temp=False)
+    text, _, _ = grid_scene(2, with_temp=False)
     a.work.mkdir(parents=True, exist_ok=True)
     scene = a.work / 'plain.inp'
     scene.write_text(text)
     run([a.bulkflow, str(scene), '--quiet'], a.work)
     _, frames = frames_of(a.work / 'plain.h5')
-    if any('TEMP' in data for _, _, data in frames) or 'TEMP' in (a.work / 'plain.xmf').read_text():
-        raise Failed('TEMP written although no request names it')
-    print(f'  {len(frames)} frames without TEMP (not requested)')
+    xmf = (a.work / 'plain.xmf').read_text()
+    if any('TEMP' in data or 'NT' in data for _, _, data in frames) or 'TEMP' in xmf or '"NT"' in xmf:
+        raise Failed('TEMP or NT written although no request names them')
+    print(f'  {len(frames)} frames without TEMP and NT (not requested)')
 
 
 def main() -> int:
