@@ -204,7 +204,18 @@ CASES = {
         repo='afshin6218517/Morteza-Naeij', path='MC-2D.for', commit='4f1624c', file='naeij_MC-2D.for',
         # E, nu, c, phi (deg), phi_res (unused), psi (deg), gamma_f (unused); Pa
         props=[1.0e7, 0.1, 2.0e3, 30.0, 30.0, 10.0, 0.2], depvar=13, density=1600.0,
-        hosts=['cpe4r', 'mpm2d', 'matpoint'], check=mohr_coulomb_check, tol=1e-6, strain=-0.02,
+        hosts=['cpe4r', 'mpm2d', 'matpoint'], check=mohr_coulomb_check, tol=1e-6,
+        # CPE4R: from an isotropic 100 kPa, compression 4 % in direction 2 with a lateral
+        # extension of 0.4 % in direction 1, so that s33 stays the intermediate principal stress
+        # (a face of the Mohr-Coulomb pyramid). On the edges (two equal principal stresses:
+        # uniaxial strain, equal in-plane compression) the file's corner branches put the
+        # stresses back in the wrong places (docs/user_subroutines.md)
+        stretch={2: [0.02, -0.02, 0.0]}, element_initial='-1.0e5, -1.0e5, -1.0e5, 0.',
+        # the prescribed motion makes the element stress independent of the density: a light
+        # one (1e-4 of the soil's) gives the 2 ms step some 200 increments instead of 2. The file
+        # returns in one step (no sub-increments); from a 1 % strain increment the return lands
+        # in the neighbouring sextant, off the surface (docs/user_subroutines.md)
+        element_density=0.16,
         # The file comments out its INCLUDE 'VABA_PARAM.INC': its undeclared variables, the
         # argument arrays among them, are default REAL (single precision) against the host's
         # double-precision arrays. Not patched: compiled here with the promotion the include
@@ -257,8 +268,9 @@ def props_text(props):
     return ',\n'.join(', '.join(repr(float(v)) for v in props[i:i + 8]) for i in range(0, len(props), 8))
 
 
-def material_block(name, case):
-    return (f'*MATERIAL, NAME={name}\n*DENSITY\n{case["density"]!r}\n'
+def material_block(name, case, density=None):
+    density = case['density'] if density is None else density
+    return (f'*MATERIAL, NAME={name}\n*DENSITY\n{density!r}\n'
             f'*USER MATERIAL, CONSTANTS={len(case["props"])}\n{props_text(case["props"])}\n'
             f'*DEPVAR\n{case["depvar"]}\n')
 
@@ -272,8 +284,11 @@ def host_elements(case, user_file, work: Path, ndim: int, check):
     text = scene.read_text()
     start = text.index('*MATERIAL')
     end = text.index('*INITIAL CONDITIONS')
-    text = text[:start] + material_block('PUBLIC', case) + text[end:]
+    text = text[:start] + material_block('PUBLIC', case, case.get('element_density')) + text[end:]
     text = text.replace('MATERIAL=PROBE-NEO', 'MATERIAL=PUBLIC')
+    if 'element_initial' in case:
+        text = text.replace('*STEP, NAME=MOVE', f'*INITIAL CONDITIONS, TYPE=STRESS\nALL, {case["element_initial"]}\n'
+                            '*STEP, NAME=MOVE')
     if rate:
         # every increment in the history: the time at the start of the last one gives its tempOld
         text = text.replace('*OUTPUT, HISTORY, NUMBER INTERVAL=10', '*OUTPUT, HISTORY, FREQUENCY=1')
@@ -297,11 +312,12 @@ def host_matpoint(case, user_file, work: Path, check):
     inp = work / 'oedometer.inp'
     temp = case.get('matpoint_temperature')
     extra = f'*INITIAL CONDITIONS, TYPE=TEMPERATURE\n{temp!r}\n' if temp is not None else ''
-    test = f'*TEST, TYPE=OEDOMETER\n*STAGE, STRAIN={case["strain"]}, INC=100\n'
     if 'matpoint' in case:
         mp = case['matpoint']
         extra += f'*INITIAL CONDITIONS, TYPE=STRESS\n{mp["initial"]}\n' if 'initial' in mp else ''
         test = f'*TEST, TYPE={mp["test"]}\n{mp["stage"]}\n'
+    else:
+        test = f'*TEST, TYPE=OEDOMETER\n*STAGE, STRAIN={case["strain"]}, INC=100\n'
     inp.write_text('*HEADING\npublic VUMAT, driver\n' + material_block('PUBLIC', case) + extra + test)
     run([str(MATPOINT), str(inp), '-o', 'oedometer.csv', '--user', str(user_file)], work)
     data = np.genfromtxt(work / 'oedometer.csv', delimiter=',', names=True)
@@ -333,11 +349,12 @@ def host_mpm(case, user_file, work: Path, ndim: int = 3):
     err = float(np.max(np.abs(fr['S'][:, 1] - want)))
     results = [('sigma_yy vs -rho g (H - y)', err, 0.05 * rho * g * height)]
     if case.get('mpm_lateral'):
-        results.append(mohr_coulomb_lateral(case, fr['S'][:, 0], fr['S'][:, 1], 0.05 * rho * g * height))
+        for k, name in ((0, 'sigma_xx'), (2, 'sigma_zz')):
+            results.append(mohr_coulomb_lateral(case, name, fr['S'][:, k], fr['S'][:, 1], 0.05 * rho * g * height))
     return results
 
 
-def mohr_coulomb_lateral(case, s_h, s_v, tol):
+def mohr_coulomb_lateral(case, name, s_h, s_v, tol):
     """A Mohr-Coulomb column at rest between frictionless walls, loaded monotonically in uniaxial
     strain (compression positive): sigma_h = K0 sigma_v while elastic, K0 = nu/(1 - nu); on the
     line sigma_h = K_a sigma_v - 2 c sqrt(K_a) (K_a = (1 - sin phi)/(1 + sin phi)) where that is
@@ -348,7 +365,7 @@ def mohr_coulomb_lateral(case, s_h, s_v, tol):
     want = np.maximum(k0 * sv, ka * sv - 2 * c * math.sqrt(ka))
     yielded = int(np.count_nonzero(ka * sv - 2 * c * math.sqrt(ka) > k0 * sv))
     err = float(np.max(np.abs(-np.asarray(s_h) - want)))
-    return (f'sigma_xx vs max(K0 sigma_v, K_a sigma_v - 2c sqrt(K_a)) ({yielded} of {len(sv)} particles '
+    return (f'{name} vs max(K0 sigma_v, K_a sigma_v - 2c sqrt(K_a)) ({yielded} of {len(sv)} particles '
             f'on the line)', err, tol)
 
 
