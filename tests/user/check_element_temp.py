@@ -69,7 +69,7 @@ def grid_scene(ndim: int, with_temp: bool = True) -> tuple[str, np.ndarray, np.n
     etype = 'CPE4R' if ndim == 2 else 'C3D8R'
     dofs = '1, 2' if ndim == 2 else '1, 3'
     lines = ['*HEADING', f'TEMP element output, {ndim}D', '*NODE']
-    lines += [f'{k + 1}, ' + ', '.join(repr(v) for v in c) for k, c in enumerate(coords)]
+    lines += [f'{k + 1}, ' + ', '.join(repr(float(v)) for v in c) for k, c in enumerate(coords)]
     lines += [f'*ELEMENT, TYPE={etype}, ELSET=ALLE']
     lines += [f'{k + 1}, ' + ', '.join(str(v) for v in e) for k, e in enumerate(elems)]
     lines += ['*NSET, NSET=ALL, GENERATE', f'1, {coords.shape[0]}, 1', '*NSET, NSET=HOT']
