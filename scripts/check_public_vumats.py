@@ -431,6 +431,7 @@ def main() -> int:
     p.add_argument('--work', type=Path, default=Path('/tmp/bulkflow_public_vumats'))
     p.add_argument('--only', nargs='+', choices=sorted(CASES), help='run these cases only')
     a = p.parse_args()
+    a.build, a.dir = a.build.resolve(), a.dir.resolve()   # the hosts run in their own folders
     BULKFLOW = a.build / 'bin' / 'bulkflow'
     MATPOINT = a.build / 'bin' / 'bulkflow-matpoint'
     os.environ.setdefault('BULKFLOW_CACHE_DIR', str(a.work / 'cache'))
