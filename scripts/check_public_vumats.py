@@ -12,13 +12,19 @@ CASES below and in the docs), into one folder, under the names CASES gives, e.g.
     python3 scripts/check_public_vumats.py --dir /tmp/public_vumats [--build build] [--only NAME ...]
 
 (pantale/abaqusVumat's Sources/VUMAT-NR.f INCLUDEs 'JohnsonCook.f': put that file, unchanged and
-under its own name, next to it, as Abaqus users do.)
+under its own name, next to it, as Abaqus users do. afshin6218517/Morteza-Naeij's MC-2D.for goes
+in as naeij_MC-2D.for.)
 
 Hosts: C3D8R and CPE4R (a homogeneous stretch, uniaxial-strain compression unless the case gives
 another, every node prescribed; with temp_rate a *TEMPERATURE ramp T0 + rate t),
 MPM (a 3D column settling under gravity between frictionless walls: sigma_yy = -rho g (H - y)
-whatever the material) and bulkflow-matpoint (an oedometer test). A host a file cannot serve
-(a VUMAT written for 3D only) is skipped and said so.
+whatever the material; the 2D column for plane-strain files) and bulkflow-matpoint (an
+oedometer test, or the case's own test). A host a file cannot serve (a VUMAT written for 3D
+only) is skipped and said so. Each case names the commit its file was checked at.
+
+A file that needs compiler flags of its own (a case with `fflags`: MC-2D.for, whose
+vaba_param.inc is commented out) is compiled unchanged by the script into an object file,
+which --user links; the docs say why.
 """
 from __future__ import annotations
 
@@ -131,16 +137,38 @@ def ice_vusdfld_check(fields, stress6):
     return [(fields[0], 0.01 + (p / 53.2429898 - 0.75) ** 2), (fields[1], 1.0 if p > -2.0 else 0.0)]
 
 
+def mohr_coulomb_check(props):
+    """Mohr-Coulomb (Naeij and Javanmardi's MC-2D.for): perfectly plastic, props E, nu, c, phi
+    (deg), phi_res and gamma_f (read, unused), psi (deg). On yielding the largest and smallest
+    principal stresses (tension positive; sigma33 is a principal stress of the plane-strain
+    state) lie on (s_max - s_min)/2 + (s_max + s_min)/2 sin(phi) = c cos(phi), i.e.
+    s_max = s_min (1 - sin phi)/(1 + sin phi) + 2 c cos(phi)/(1 + sin phi): in compression
+    positive, sigma_3 = sigma_1 K_a - 2 c sqrt(K_a), K_a = (1 - sin phi)/(1 + sin phi). The file
+    adds the plastic increments of strainInc(2) to its SDV10, so SDV10 /= 0 says it yielded."""
+    c, phi = props[2], math.radians(props[3])
+    s = math.sin(phi)
+
+    def check(stress6, sdv, ctx=None):
+        s11, s22, s33, s12 = (float(v) for v in stress6[:4])
+        mean, radius = 0.5 * (s11 + s22), math.hypot(0.5 * (s11 - s22), s12)
+        principal = sorted([mean - radius, mean + radius, s33])
+        if sdv[9] == 0:
+            raise uc.Failed(f'no plastic increment (SDV10 = 0; principal stresses {principal}); the path must yield')
+        want = principal[0] * (1 - s) / (1 + s) + 2 * c * math.cos(phi) / (1 + s)
+        return [('largest principal stress on the Mohr-Coulomb line', principal[2], want)]
+    return check
+
+
 # name -> (repository, path in it, file name in --dir, props, depvar, kinds of host, check, comment)
 CASES = {
     'johnson_cook': dict(
-        repo='irfancn/Abaqus-VUMAT-Johnson-Cook', path='vumat_JC.for', file='irfancn_vumat_JC.for',
+        repo='irfancn/Abaqus-VUMAT-Johnson-Cook', path='vumat_JC.for', commit='9b99631', file='irfancn_vumat_JC.for',
         # E, nu, A, B, C (rate: 0), n, m, rate0, Tr, Tm, rho, TQ, Cp, WH (heating: 0)
         props=[2.1e11, 0.3, 8e8, 6e8, 0.0, 0.168, 1.1, 1.0, 293.0, 1700.0, 7800.0, 34.0, 460.0, 0.0],
         depvar=6, density=7800.0, hosts=['c3d8r', 'matpoint', 'mpm3d'], check=jc_check, tol=1e-6, strain=-0.02,
         what='J2 plasticity with Johnson-Cook hardening (3D only: it reads stress components 1..6)'),
     'ice_tsai_wu': dict(
-        repo='NTNU-IMT/Ice-Elastoplastic-Material-Model', path='src/VUMAT-ICE-Elastoplastic.for',
+        repo='NTNU-IMT/Ice-Elastoplastic-Material-Model', path='src/VUMAT-ICE-Elastoplastic.for', commit='4a2a3e9',
         file='ntnu_imt_VUMAT-ICE-Elastoplastic.for',
         # MPa: E, nu, a0, a1, a2, eps0 (failure strain: 10, no damage), pcut, M, N, Gf1, Gf2, alphad
         props=[9500.0, 0.3, 22.93, 2.06, -0.023, 10.0, -2.0, 1.0, 0.75, 1.0, 1.0, 1.0],
@@ -151,7 +179,7 @@ CASES = {
         strain=-0.004,
         what='pressure-dependent (Tsai-Wu) plasticity of ice, single-precision locals'),
     'johnson_cook_thermal': dict(
-        repo='pantale/abaqusVumat', path='Sources/VUMAT-NR.f (INCLUDEs Sources/JohnsonCook.f)',
+        repo='pantale/abaqusVumat', path='Sources/VUMAT-NR.f (INCLUDEs Sources/JohnsonCook.f)', commit='3be9d7e',
         file='pantale_VUMAT-NR.f', needs=['JohnsonCook.f'],
         # E, nu, A, B, n, C (rate: 0), m, eps0_dot, T0, Tm, Taylor-Quinney (heating: 0), rho0, Cp,
         # coupled = 1 (temperature from the host's tempOld)
@@ -163,6 +191,7 @@ CASES = {
         what='J2 plasticity, Johnson-Cook hardening with thermal softening from tempOld (*TEMPERATURE)'),
     'evans_skalak': dict(
         repo='nima-mostafa-zadeh/Shell-FEM', path='abaqus/models/stretching/evans_skalak/evans_skalak_vumat.f',
+        commit='49c4288',
         file='shellfem_evans_skalak_vumat.f',
         # mu, K' (the file's area constant, K' = -K: area modulus K = 2e6)
         props=[1.0e6, -2.0e6], depvar=4, density=1000.0, hosts=['cpe4r', 'c3d8r'], check=evans_skalak_check,
@@ -171,8 +200,40 @@ CASES = {
              'matpoint': "the file writes no shear stress: the driver's two-point packaging probe finds "
                          '2G = 0 and stops naming the material'},
         what='hyperelastic membrane (Evans-Skalak) from defgradNew'),
+    'mohr_coulomb_2d': dict(
+        repo='afshin6218517/Morteza-Naeij', path='MC-2D.for', commit='4f1624c', file='naeij_MC-2D.for',
+        # E, nu, c, phi (deg), phi_res (unused), psi (deg), gamma_f (unused); Pa
+        props=[1.0e7, 0.1, 2.0e3, 30.0, 30.0, 10.0, 0.2], depvar=13, density=1600.0,
+        hosts=['cpe4r', 'mpm2d', 'matpoint'], check=mohr_coulomb_check, tol=1e-6,
+        # CPE4R: from an isotropic 100 kPa, compression 4 % in direction 2 with a lateral
+        # extension of 0.4 % in direction 1, so that s33 stays the intermediate principal stress
+        # (a face of the Mohr-Coulomb pyramid). On the edges (two equal principal stresses:
+        # uniaxial strain, equal in-plane compression) the file's corner branches put the
+        # stresses back in the wrong places (docs/user_subroutines.md)
+        stretch={2: [0.02, -0.02, 0.0]}, element_initial='-1.0e5, -1.0e5, -1.0e5, 0.',
+        # the prescribed motion makes the element stress independent of the density: a light
+        # one (1e-4 of the soil's) gives the 2 ms step some 200 increments instead of 2. The file
+        # returns in one step (no sub-increments); from a 1 % strain increment the return lands
+        # in the neighbouring sextant, off the surface (docs/user_subroutines.md)
+        element_density=0.16,
+        # The file comments out its INCLUDE 'VABA_PARAM.INC': its undeclared variables, the
+        # argument arrays among them, are default REAL (single precision) against the host's
+        # double-precision arrays. Not patched: compiled here with the promotion the include
+        # would have declared (implicit double precision) and given to --user as an object.
+        fflags=['-fdefault-real-8', '-fdefault-double-8'],
+        # driver: plane-strain biaxial compression from an isotropic 100 kPa, the lateral stress held
+        matpoint=dict(test='BIAXIAL, DIMENSION=2', initial='-1.0e5, -1.0e5, -1.0e5, 0.',
+                      stage='*STAGE, STRAIN=-0.05, STRESS=-1.0e5, INC=200'),
+        # MPM: also the lateral stress of the column, K0 = nu/(1 - nu) above the depth where it
+        # yields, on the Mohr-Coulomb line (sigma_h = K_a sigma_v - 2 c sqrt(K_a)) below
+        mpm_lateral=True,
+        why={'c3d8r': 'a plane-strain model (MC-2D: principal stresses from s11, s22, s12 and s33; s23, s31 '
+                      'neither read nor written)',
+             'mpm3d': 'a plane-strain model; the 2D column (mpm2d) runs it'},
+        what='Mohr-Coulomb, perfectly plastic, non-associated (dilation angle), plane strain; '
+             'its vaba_param.inc commented out (single-precision implicit typing)'),
     'ice_vusdfld': dict(
-        repo='NTNU-IMT/Ice-Elastoplastic-Material-Model', path='src/VUSDFLD.for', file='ntnu_imt_VUSDFLD.for',
+        repo='NTNU-IMT/Ice-Elastoplastic-Material-Model', path='src/VUSDFLD.for', commit='4a2a3e9', file='ntnu_imt_VUSDFLD.for',
         # a VUSDFLD only: on our *MOHR COULOMB (MPa: E, nu; phi, psi; c), which has the PEEQ it reads
         vusdfld=dict(e=9500.0, nu=0.3, c=1.0, density=9.0e-4, strain=-0.004, angles='30., 0.', fields=2),
         hosts=['cpe4r', 'c3d8r'], check=ice_vusdfld_check, tol=1e-6,
@@ -207,8 +268,9 @@ def props_text(props):
     return ',\n'.join(', '.join(repr(float(v)) for v in props[i:i + 8]) for i in range(0, len(props), 8))
 
 
-def material_block(name, case):
-    return (f'*MATERIAL, NAME={name}\n*DENSITY\n{case["density"]!r}\n'
+def material_block(name, case, density=None):
+    density = case['density'] if density is None else density
+    return (f'*MATERIAL, NAME={name}\n*DENSITY\n{density!r}\n'
             f'*USER MATERIAL, CONSTANTS={len(case["props"])}\n{props_text(case["props"])}\n'
             f'*DEPVAR\n{case["depvar"]}\n')
 
@@ -222,8 +284,11 @@ def host_elements(case, user_file, work: Path, ndim: int, check):
     text = scene.read_text()
     start = text.index('*MATERIAL')
     end = text.index('*INITIAL CONDITIONS')
-    text = text[:start] + material_block('PUBLIC', case) + text[end:]
+    text = text[:start] + material_block('PUBLIC', case, case.get('element_density')) + text[end:]
     text = text.replace('MATERIAL=PROBE-NEO', 'MATERIAL=PUBLIC')
+    if 'element_initial' in case:
+        text = text.replace('*STEP, NAME=MOVE', f'*INITIAL CONDITIONS, TYPE=STRESS\nALL, {case["element_initial"]}\n'
+                            '*STEP, NAME=MOVE')
     if rate:
         # every increment in the history: the time at the start of the last one gives its tempOld
         text = text.replace('*OUTPUT, HISTORY, NUMBER INTERVAL=10', '*OUTPUT, HISTORY, FREQUENCY=1')
@@ -242,23 +307,31 @@ def host_elements(case, user_file, work: Path, ndim: int, check):
 
 
 def host_matpoint(case, user_file, work: Path, check):
+    """The driver: an oedometer test (uniaxial strain), or the case's own test (`matpoint`)."""
     work.mkdir(parents=True, exist_ok=True)
     inp = work / 'oedometer.inp'
     temp = case.get('matpoint_temperature')
     extra = f'*INITIAL CONDITIONS, TYPE=TEMPERATURE\n{temp!r}\n' if temp is not None else ''
-    inp.write_text('*HEADING\npublic VUMAT, oedometer\n' + material_block('PUBLIC', case) + extra
-                   + f'*TEST, TYPE=OEDOMETER\n*STAGE, STRAIN={case["strain"]}, INC=100\n')
+    if 'matpoint' in case:
+        mp = case['matpoint']
+        extra += f'*INITIAL CONDITIONS, TYPE=STRESS\n{mp["initial"]}\n' if 'initial' in mp else ''
+        test = f'*TEST, TYPE={mp["test"]}\n{mp["stage"]}\n'
+    else:
+        test = f'*TEST, TYPE=OEDOMETER\n*STAGE, STRAIN={case["strain"]}, INC=100\n'
+    inp.write_text('*HEADING\npublic VUMAT, driver\n' + material_block('PUBLIC', case) + extra + test)
     run([str(MATPOINT), str(inp), '-o', 'oedometer.csv', '--user', str(user_file)], work)
     data = np.genfromtxt(work / 'oedometer.csv', delimiter=',', names=True)
-    s6 = [data[c][-1] for c in ('s11', 's22', 's33', 's12', 's23', 's31')]
+    s6 = [data[c][-1] if c in data.dtype.names else 0.0 for c in ('s11', 's22', 's33', 's12', 's23', 's31')]
     sdv = [data[f'SDV{i}'][-1] for i in range(1, case['depvar'] + 1)]
     return check(s6, sdv, {'temp_old': temp, 'temp_new': temp})
 
 
-def host_mpm3d(case, user_file, work: Path):
-    """Vertical equilibrium of a column between frictionless walls, any material."""
+def host_mpm(case, user_file, work: Path, ndim: int = 3):
+    """Vertical equilibrium of a column between frictionless walls, any material (3D:
+    inputs/mpm/column_k0_3d.inp, 2D: column_k0_2d.inp, with the case's material). With
+    `mpm_lateral`, also the Mohr-Coulomb column's lateral stress (mohr_coulomb_lateral)."""
     work.mkdir(parents=True, exist_ok=True)
-    text = (REPO / 'inputs' / 'mpm' / 'column_k0_3d.inp').read_text()
+    text = (REPO / 'inputs' / 'mpm' / f'column_k0_{ndim}d.inp').read_text()
     start = text.index('*MATERIAL')
     end = text.index('*PARTICLES')
     text = text[:start] + material_block('SOIL', case) + text[end:]
@@ -269,9 +342,52 @@ def host_mpm3d(case, user_file, work: Path):
     fr = uc.last_frame(work / 'column.h5', 'particles')
     y = fr['coordinates'][:, 1]
     rho, g, height = case['density'], 9.81, 1.0
-    want = -rho * g * height * (y.max() + 0.05 - y) / (y.max() + 0.05)
+    # the top of the column: half a particle spacing above the highest particle (2D: cell 0.05,
+    # 2 particles per cell; the 3D figure is the one this check has always used)
+    top = y.max() + (0.05 if ndim == 3 else 0.0125)
+    want = -rho * g * height * (top - y) / top
     err = float(np.max(np.abs(fr['S'][:, 1] - want)))
-    return err, 0.05 * rho * g * height
+    results = [('sigma_yy vs -rho g (H - y)', err, 0.05 * rho * g * height)]
+    if case.get('mpm_lateral'):
+        for k, name in ((0, 'sigma_xx'), (2, 'sigma_zz')):
+            results.append(mohr_coulomb_lateral(case, name, fr['S'][:, k], fr['S'][:, 1], 0.05 * rho * g * height))
+    return results
+
+
+def mohr_coulomb_lateral(case, name, s_h, s_v, tol):
+    """A Mohr-Coulomb column at rest between frictionless walls, loaded monotonically in uniaxial
+    strain (compression positive): sigma_h = K0 sigma_v while elastic, K0 = nu/(1 - nu); on the
+    line sigma_h = K_a sigma_v - 2 c sqrt(K_a) (K_a = (1 - sin phi)/(1 + sin phi)) where that is
+    larger, i.e. once K0 sigma_v would fall below it: sigma_h = max of the two."""
+    nu, c, phi = case['props'][1], case['props'][2], math.radians(case['props'][3])
+    k0, ka = nu / (1 - nu), (1 - math.sin(phi)) / (1 + math.sin(phi))
+    sv = -np.asarray(s_v)
+    want = np.maximum(k0 * sv, ka * sv - 2 * c * math.sqrt(ka))
+    yielded = int(np.count_nonzero(ka * sv - 2 * c * math.sqrt(ka) > k0 * sv))
+    err = float(np.max(np.abs(-np.asarray(s_h) - want)))
+    return (f'{name} vs max(K0 sigma_v, K_a sigma_v - 2c sqrt(K_a)) ({yielded} of {len(sv)} particles '
+            f'on the line)', err, tol)
+
+
+def compile_object(case, source: Path, work: Path, build: Path) -> Path:
+    """A file that needs compiler flags of its own (`fflags`) is compiled here, unchanged, by the
+    build's Fortran compiler with the flags --user uses for fixed form plus those, into an
+    object file that --user links (docs/user_subroutines.md: `.o` files)."""
+    work.mkdir(parents=True, exist_ok=True)
+    compiler = 'gfortran'
+    cache = build / 'CMakeCache.txt'
+    if cache.exists():
+        for line in cache.read_text().splitlines():
+            if line.startswith('CMAKE_Fortran_COMPILER:'):
+                compiler = line.split('=', 1)[1]
+    obj = work / (source.stem + '.o')
+    cmd = [compiler, '-c', '-fPIC', '-O2', '-ffixed-form', '-ffixed-line-length-132', *case['fflags'],
+           '-I', str(source.parent), '-I', str(build / 'abaqus_include'), str(source), '-o', str(obj)]
+    print(f'  compiled unchanged: {" ".join(cmd)}')
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise uc.Failed(f'{" ".join(cmd)}\n{proc.stderr[-2000:]}')
+    return obj
 
 
 def verdict(ok: bool) -> str:
@@ -286,11 +402,12 @@ def run_host(case, host, user_file, work, check):
         print(f'  {host:9s} fields ' + ', '.join(f'{g:.9e} (closed form {w:.9e})' for g, w in pairs)
               + f' {verdict(ok)}')
         return 0 if ok else 1
-    if host == 'mpm3d':
-        err, tol = host_mpm3d(case, user_file, work)
-        print(f'  {host:9s} sigma_yy vs -rho g (H - y): max error {err:.3e} (limit {tol:.1e})'
-              f' {verdict(err <= tol)}')
-        return 0 if err <= tol else 1
+    if host in ('mpm2d', 'mpm3d'):
+        failures = 0
+        for label, err, tol in host_mpm(case, user_file, work, 2 if host == 'mpm2d' else 3):
+            print(f'  {host:9s} {label}: max error {err:.3e} (limit {tol:.1e}) {verdict(err <= tol)}')
+            failures += 0 if err <= tol else 1
+        return failures
     if host == 'matpoint':
         result = host_matpoint(case, user_file, work, check)
     else:
@@ -314,6 +431,7 @@ def main() -> int:
     p.add_argument('--work', type=Path, default=Path('/tmp/bulkflow_public_vumats'))
     p.add_argument('--only', nargs='+', choices=sorted(CASES), help='run these cases only')
     a = p.parse_args()
+    a.build, a.dir = a.build.resolve(), a.dir.resolve()   # the hosts run in their own folders
     BULKFLOW = a.build / 'bin' / 'bulkflow'
     MATPOINT = a.build / 'bin' / 'bulkflow-matpoint'
     os.environ.setdefault('BULKFLOW_CACHE_DIR', str(a.work / 'cache'))
@@ -322,15 +440,24 @@ def main() -> int:
         if a.only and name not in a.only:
             continue
         user_file = a.dir / case['file']
-        print(f'{name}: {case["repo"]} {case["path"]} ({case["what"]})')
+        print(f'{name}: {case["repo"]} {case["path"]} (commit {case["commit"]}; {case["what"]})')
         missing = [f for f in [case['file'], *case.get('needs', [])] if not (a.dir / f).exists()]
         if missing:
             print(f'  missing {", ".join(str(a.dir / f) for f in missing)}: download first  FAIL')
             failures += 1
             continue
         check = case['check'](case['props']) if 'props' in case else None
-        for host in ('cpe4r', 'c3d8r', 'mpm3d', 'matpoint'):
+        if 'fflags' in case:
+            try:
+                user_file = compile_object(case, user_file, a.work / name, a.build)
+            except uc.Failed as exc:
+                print(f'  compile  FAIL: {exc}')
+                failures += 1
+                continue
+        for host in ('cpe4r', 'c3d8r', 'mpm2d', 'mpm3d', 'matpoint'):
             if host not in case['hosts']:
+                if host == 'mpm2d' and 'mpm2d' not in case.get('why', {}):
+                    continue   # the 2D column is run for plane-strain-only files
                 why = {'mpm3d': 'particles write no FV', 'matpoint': 'the driver keeps its own VUSDFLD door'}
                 reason = why[host] if check is None else case.get('why', {}).get(host, 'the file does not serve it')
                 print(f'  {host:9s} skipped ({reason})')

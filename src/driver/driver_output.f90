@@ -16,6 +16,7 @@ module driver_output
   use output_history, only: history_t, history_open, history_row, history_close, history_row_count
   use fem_corotation, only: stored_to_global
   use driver_stop_condition, only: count_stop_columns, add_stop_columns, stop_column_values
+  use driver_temperature, only: frame_temperatures, frame_node_temperatures
   implicit none
   private
 
@@ -154,7 +155,7 @@ contains
           do k = 1, size(f%node_variables)
              if (any(written == f%node_variables(k))) cycle
              written = [character(len=8) :: written, f%node_variables(k)]
-             call write_node_variable(solver, out, trim(f%node_variables(k)))
+             call write_node_variable(m, solver, out, trim(f%node_variables(k)))
           end do
        end if
        if (allocated(f%element_variables)) then
@@ -168,10 +169,12 @@ contains
     call field_writer_end_frame(out%fields)
   end subroutine write_frame
 
-  subroutine write_node_variable(solver, out, name)
+  subroutine write_node_variable(m, solver, out, name)
+    type(model_t), intent(in) :: m
     type(solver_t), intent(in) :: solver
     type(run_output_t), intent(inout) :: out
     character(len=*), intent(in) :: name
+    real(dp), allocatable :: node_temp(:)
 
     associate (p => solver%part)
       select case (name)
@@ -183,6 +186,10 @@ contains
          call field_writer_node_field(out%fields, 'A', p%node_global, p%node_owned, solver%a)
       case ('RF')
          call field_writer_node_field(out%fields, 'RF', p%node_global, p%node_owned, solver%reaction)
+      case ('NT')
+         call frame_node_temperatures(m, solver, node_temp)
+         call field_writer_node_field(out%fields, 'NT', p%node_global, p%node_owned, &
+              reshape(node_temp(p%node_global), [1, size(p%node_global)]))
       end select
     end associate
   end subroutine write_node_variable
@@ -265,6 +272,10 @@ contains
        allocate(values(n, 1))
        values = 1
        call field_writer_element_field(out%fields, 'STATUS', solver%part%elem_global, values)
+    case ('TEMP')
+       allocate(values(n, 1))
+       call frame_temperatures(m, solver, values(:, 1))
+       call field_writer_element_field(out%fields, 'TEMP', solver%part%elem_global, values)
     end select
   contains
 

@@ -243,26 +243,28 @@ contains
     select case (blk%name)
     case ('NODE OUTPUT')
        if (os%current_is_field) then
-          call node_field_output(blk, os, err)
+          call node_field_output(blk, model%mpm%active, os, err)
        else
           call node_history_output(blk, model, os, err)
        end if
     case ('ELEMENT OUTPUT')
-       call element_output(blk, model%mpm%active, os, err)
+       call element_output(blk, os, err)
     case default
        call energy_output(blk, os, err)
     end select
   end subroutine read_output_option
 
-  subroutine node_field_output(blk, os, err)
+  !> particles: a material-point scene (no node fields are written; NT is refused there).
+  subroutine node_field_output(blk, particles, os, err)
     type(keyword_block_t), intent(in) :: blk
+    logical, intent(in) :: particles
     type(output_state_t), intent(inout) :: os
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: name
     integer :: il, k
 
     call blk%check_params([character(len=8) ::], err)
-    if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'variable names U, V, A, RF', err)
+    if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'variable names U, V, A, RF, NT', err)
     if (err%raised) return
     do il = 1, blk%n_lines
        do k = 1, blk%lines(il)%n_fields()
@@ -271,9 +273,17 @@ contains
           select case (name)
           case ('U', 'V', 'A', 'RF')
              call add_name(os%field(os%n_field)%node_variables, name)
+          case ('NT')
+             if (particles) then
+                call raise_error(blk%lines(il)%file, blk%lines(il)%line, 'node field output variable NT ' // &
+                     'is written for the nodes of element scenes; expected TEMP in *ELEMENT OUTPUT for ' // &
+                     'the particles of a material-point scene', err)
+                return
+             end if
+             call add_name(os%field(os%n_field)%node_variables, name)
           case default
              call raise_error(blk%lines(il)%file, blk%lines(il)%line, 'node field output variable ' // &
-                  name // ' is not available; expected U, V, A or RF', err)
+                  name // ' is not available; expected U, V, A, RF or NT', err)
              return
           end select
        end do
@@ -337,10 +347,9 @@ contains
     call push_history(os, h)
   end subroutine node_history_output
 
-  !> particles: a material-point scene, whose particles also write TEMP (their temperature).
-  subroutine element_output(blk, particles, os, err)
+  !> TEMP: the temperature of the elements (mean of their nodes') or of the particles.
+  subroutine element_output(blk, os, err)
     type(keyword_block_t), intent(in) :: blk
-    logical, intent(in) :: particles
     type(output_state_t), intent(inout) :: os
     type(error_t), intent(inout) :: err
     character(len=:), allocatable :: name, directions
@@ -355,26 +364,18 @@ contains
     call blk%check_params([character(len=10) :: 'DIRECTIONS'], err)
     if (.not. err%raised) call blk%get_string('DIRECTIONS', directions, err, default='YES', &
          choices=[character(len=3) :: 'YES', 'NO'])
-    if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'variable names S, LE, PE, PEEQ, SDV, FV, STATUS', err)
+    if (.not. err%raised) call expect_lines(blk, 1, huge(1), 'variable names S, LE, PE, PEEQ, SDV, FV, STATUS, TEMP', err)
     if (err%raised) return
     do il = 1, blk%n_lines
        do k = 1, blk%lines(il)%n_fields()
           if (field_blank(blk%lines(il), k)) cycle
           name = field_name(blk%lines(il), k)
           select case (name)
-          case ('S', 'LE', 'PE', 'PEEQ', 'SDV', 'FV', 'STATUS')
-             call add_name(os%field(os%n_field)%element_variables, name)
-          case ('TEMP')
-             if (.not. particles) then
-                call raise_error(blk%lines(il)%file, blk%lines(il)%line, 'element output variable TEMP ' // &
-                     'is written for the particles of material-point scenes only; expected S, LE, PE, PEEQ, ' // &
-                     'SDV, FV or STATUS', err)
-                return
-             end if
+          case ('S', 'LE', 'PE', 'PEEQ', 'SDV', 'FV', 'STATUS', 'TEMP')
              call add_name(os%field(os%n_field)%element_variables, name)
           case default
              call raise_error(blk%lines(il)%file, blk%lines(il)%line, 'element output variable ' // &
-                  name // ' is not available; expected S, LE, PE, PEEQ, SDV, FV or STATUS', err)
+                  name // ' is not available; expected S, LE, PE, PEEQ, SDV, FV, STATUS or TEMP', err)
              return
           end select
        end do
