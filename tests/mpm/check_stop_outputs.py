@@ -98,9 +98,11 @@ def main():
             scheduled_row = rule['history'][-1][1] > t_stop - 1e-12
             report(close(rows, want['history']),
                    f'{solver:7s} --stop-after {stop}: {len(rows)} history rows, the last at {rows[-1][1]:.4f} '
-                   f'({"the schedule" + chr(39) + "s, not repeated" if scheduled_row else "the stop" + chr(39) + "s"})')
+                   f'(want {len(want["history"])}, the last at {t_stop:.4f}: '
+                   f'{"the schedule" + chr(39) + "s, not repeated" if scheduled_row else "the stop" + chr(39) + "s"})')
             report(close(frames, want['field']),
-                   f'{solver:7s} --stop-after {stop}: {len(frames)} frames, the last at {frames[-1][1]:.4f} (the stop\'s)')
+                   f'{solver:7s} --stop-after {stop}: {len(frames)} frames, the last at {frames[-1][1]:.4f} '
+                   f'(want {len(want["field"])}, the last the stop\'s at {t_stop:.4f})')
         # restart from the stop at 37 to the end == an uninterrupted run
         full = a.workdir / f'{solver}_full'
         run(a.bulkflow, scene, full)
