@@ -17,7 +17,6 @@ checks, for each technique:
 """
 import argparse
 import csv
-import subprocess
 import sys
 from pathlib import Path
 
@@ -25,17 +24,10 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from check_schedule import expected  # noqa: E402  (the schedule rule, computed independently)
+from check_schedule import expected, run  # noqa: E402  (the schedule rule, computed independently)
 
 GROUP = {'element': 'frames', 'mpm': 'particles'}
 PERIOD_1 = 0.1
-
-
-def run(exe, scene, base, *extra):
-    r = subprocess.run([exe, str(scene), '--output', str(base), '--quiet', *extra], capture_output=True, text=True)
-    if r.returncode != 0:
-        print(r.stdout, r.stderr)
-        sys.exit(f'FAIL: {scene} {" ".join(extra)}: exit status {r.returncode}')
 
 
 def frame_times(h5, group):
