@@ -4,7 +4,12 @@ exit status, the history CSV (bytes) and every dataset and attribute of the .h5 
 must be identical.
 
     python3 scripts/compare_binaries.py OLD_BIN NEW_BIN DECK... [--stop-after 300] [--workdir DIR]
-                                        [--ranks N [--mpiexec mpirun]]
+                                        [--ranks N [--mpiexec mpirun]] [--timeout S] [--stop-outputs]
+
+--stop-after 0 runs every deck to its end. --stop-outputs compares an OLD binary from before the
+--stop-after rule of issue 18 (the element solver wrote no row or frame at the stop) with a NEW one
+that has it: the new history may end with one row more and the new .h5 may hold one frame more
+(the stop's), everything the old wrote must be the same bytes.
 
 OLD_BIN is typically main's build (build it from a clean checkout of main), NEW_BIN the branch's.
 Prints one line per deck and exits 1 if any deck differs.
@@ -48,6 +53,22 @@ def h5_differences(a: Path, b: Path) -> list[str]:
     return out
 
 
+def stop_frame_only(a: Path, b: Path, diffs: list[str]) -> tuple[list[str], str]:
+    """With --stop-outputs: are the differences only one frame group more in b (the last of its
+    frame list, the stop's) and the attributes that count frames? Returns the remaining
+    differences and the added frame's name."""
+    with h5py.File(a, 'r') as f1, h5py.File(b, 'r') as f2:
+        for top in ('frames', 'particles', 'grid'):
+            if top not in f1 or top not in f2:
+                continue
+            k1, k2 = sorted(f1[top].keys()), sorted(f2[top].keys())
+            if len(k2) == len(k1) + 1 and k2[:-1] == k1:
+                added = f'{top}/{k2[-1]}'
+                rest = [d for d in diffs if d != f'members of /{top}']
+                return rest, added
+    return diffs, ''
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('old')
@@ -57,6 +78,9 @@ def main(argv=None) -> int:
     ap.add_argument('--workdir', type=Path, help='keep the outputs here (default: a scratch directory)')
     ap.add_argument('--ranks', type=int, default=1, help='MPI ranks per run (default 1: no mpiexec)')
     ap.add_argument('--mpiexec', default='mpirun', help='launcher for --ranks > 1 (default mpirun)')
+    ap.add_argument('--timeout', type=float, default=600, help='seconds per run (default 600)')
+    ap.add_argument('--stop-outputs', action='store_true',
+                    help='allow the new binary one extra history row and frame at the stop (see above)')
     a = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix='bulkflow_compare_') as tmp:
         work = a.workdir or Path(tmp)
@@ -67,23 +91,31 @@ def main(argv=None) -> int:
             for tag, exe in (('old', a.old), ('new', a.new)):
                 base = work / f'{deck.stem}_{tag}'
                 launch = [a.mpiexec, '-np', str(a.ranks), '--oversubscribe'] if a.ranks > 1 else []
-                p = subprocess.run(launch + [exe, str(deck.resolve()), '--output', str(base), '--stop-after',
-                                             str(a.stop_after), '--quiet'], capture_output=True, text=True,
-                                   timeout=600)
+                stop = ['--stop-after', str(a.stop_after)] if a.stop_after > 0 else []
+                p = subprocess.run(launch + [exe, str(deck.resolve()), '--output', str(base), *stop, '--quiet'],
+                                   capture_output=True, text=True, timeout=a.timeout)
                 runs.append((base, p.returncode))
             (b0, r0), (b1, r1) = runs
             h0, h1 = Path(f'{b0}_history.csv'), Path(f'{b1}_history.csv')
             same_history = h0.exists() == h1.exists() and (not h0.exists() or h0.read_bytes() == h1.read_bytes())
+            extra = ''
+            if a.stop_outputs and not same_history and h0.exists() and h1.exists():
+                old, new = h0.read_bytes(), h1.read_bytes()
+                same_history = new.startswith(old) and new[len(old):].count(b'\n') <= 1
+                extra = ' (+1 row at the stop)' if same_history else ''
             f0, f1 = Path(f'{b0}.h5'), Path(f'{b1}.h5')
             if f0.exists() and f1.exists():
                 diffs = h5_differences(f0, f1)
+                if a.stop_outputs and diffs:
+                    diffs, added = stop_frame_only(f0, f1, diffs)
+                    extra += f' (+frame {added} at the stop)' if added else ''
             else:
                 diffs = [] if f0.exists() == f1.exists() else ['.h5 written by one binary only']
             ok = r0 == r1 and same_history and not diffs
             differ += not ok
             print(f'{"same" if ok else "DIFFERS"}  {deck}: exit {r0}/{r1}, history '
                   f'{"identical" if same_history else "differs"}, .h5 '
-                  f'{"identical" if not diffs else ", ".join(diffs[:4])}')
+                  f'{"identical" if not diffs else ", ".join(diffs[:4])}{extra}')
     print('all identical' if not differ else f'{differ} of {len(a.decks)} decks differ')
     return 1 if differ else 0
 

@@ -1,107 +1,64 @@
-!> The effects registry: which pieces of physics a scene calls for, decided once from the
-!> model before the first increment, and the wall time each one costs. The driver runs only
-!> the active effects: an inactive one is never called, allocates nothing and has no timer,
-!> so it shows no time in the report.
+!> The element solver's effects: their ids and which of them a scene calls for, declared once
+!> from the model before the first increment into the run's registry (output_effects). The
+!> driver runs only the active effects: an inactive one is never called, allocates nothing and
+!> has no timer, so it shows no time in the report. Output and checkpoints are the run
+!> skeleton's effects (src/run).
 module driver_effects
   use model, only: model_t
-  use output_timer, only: timer_set_t, timer_init, timer_register, timer_start, timer_stop
+  use output_effects, only: effects_t, first_technique_effect
   implicit none
   private
 
-  integer, parameter, public :: effect_elements = 1        !< kinematics and internal forces
-  integer, parameter, public :: effect_material = 2        !< VUMAT calls
-  integer, parameter, public :: effect_user_field = 3      !< VUSDFLD calls and the LE they read
-  integer, parameter, public :: effect_hourglass = 4
-  integer, parameter, public :: effect_bulk_viscosity = 5
-  integer, parameter, public :: effect_gravity = 6
-  integer, parameter, public :: effect_rigid_walls = 7     !< contact with friction
-  integer, parameter, public :: effect_boundary = 8        !< prescribed displacement/velocity
-  integer, parameter, public :: effect_assembly = 9        !< force assembly incl. MPI exchange
-  integer, parameter, public :: effect_output = 10         !< field, history, progress
-  integer, parameter, public :: effect_checkpoint = 11
-  integer, parameter, public :: effect_pressure = 12       !< *DSLOAD follower pressure
-  integer, parameter, public :: n_effects = 12
+  integer, parameter, public :: effect_elements = first_technique_effect   !< kinematics and internal forces
+  integer, parameter, public :: effect_material = first_technique_effect + 1   !< VUMAT calls
+  integer, parameter, public :: effect_user_field = first_technique_effect + 2 !< VUSDFLD calls and the LE they read
+  integer, parameter, public :: effect_hourglass = first_technique_effect + 3
+  integer, parameter, public :: effect_bulk_viscosity = first_technique_effect + 4
+  integer, parameter, public :: effect_gravity = first_technique_effect + 5
+  integer, parameter, public :: effect_rigid_walls = first_technique_effect + 6  !< contact with friction
+  integer, parameter, public :: effect_boundary = first_technique_effect + 7     !< prescribed displacement/velocity
+  integer, parameter, public :: effect_assembly = first_technique_effect + 8     !< force assembly incl. MPI exchange
+  integer, parameter, public :: effect_pressure = first_technique_effect + 9     !< *DSLOAD follower pressure
 
-  character(len=16), parameter, public :: effect_names(n_effects) = [character(len=16) :: &
-       'elements', 'material', 'user field', 'hourglass', 'bulk viscosity', 'gravity', &
-       'rigid walls', 'boundary', 'assembly', 'output', 'checkpoint', 'pressure']
-
-  type, public :: effects_t
-     logical :: active(n_effects) = .false.
-     integer :: timer_id(n_effects) = 0
-     type(timer_set_t) :: timers
-   contains
-     procedure :: decide => effects_decide
-     procedure :: start => effects_start
-     procedure :: stop => effects_stop
-     procedure :: active_list => effects_active_list
-  end type effects_t
+  public :: declare_element_effects
 
 contains
 
-  !> Decide from the scene which effects exist in any step, and give each a timer.
-  subroutine effects_decide(this, m)
-    class(effects_t), intent(inout) :: this
+  !> Declare the element solver's effects: those any step of the scene needs are active.
+  subroutine declare_element_effects(m, fx)
     type(model_t), intent(in) :: m
+    type(effects_t), intent(inout) :: fx
+    logical :: user_field, gravity, pressure, bulk, walls, boundary
     integer :: i
 
-    this%active = .false.
-    this%active(effect_elements) = m%mesh%n_elems > 0
-    this%active(effect_material) = m%mesh%n_elems > 0
-    ! One-point elements always need hourglass control.
-    this%active(effect_hourglass) = m%mesh%n_elems > 0
-    this%active(effect_assembly) = .true.
-    this%active(effect_output) = .true.
+    user_field = .false.
     do i = 1, m%n_materials
-       if (m%materials(i)%user_field) this%active(effect_user_field) = .true.
+       if (m%materials(i)%user_field) user_field = .true.
     end do
+    gravity = .false.
+    pressure = .false.
+    bulk = .false.
+    walls = .false.
+    boundary = .false.
     do i = 1, m%n_steps
        associate (s => m%steps(i))
-         if (allocated(s%gravity)) then
-            if (size(s%gravity) > 0) this%active(effect_gravity) = .true.
-         end if
-         if (allocated(s%pressures)) then
-            if (size(s%pressures) > 0) this%active(effect_pressure) = .true.
-         end if
-         if (s%bulk_linear > 0 .or. s%bulk_quadratic > 0) this%active(effect_bulk_viscosity) = .true.
-         if (allocated(s%contact_pairs)) then
-            if (size(s%contact_pairs) > 0) this%active(effect_rigid_walls) = .true.
-         end if
-         if (allocated(s%boundaries)) then
-            if (size(s%boundaries) > 0) this%active(effect_boundary) = .true.
-         end if
-         if (s%restart_write) this%active(effect_checkpoint) = .true.
+         if (allocated(s%gravity)) gravity = gravity .or. size(s%gravity) > 0
+         if (allocated(s%pressures)) pressure = pressure .or. size(s%pressures) > 0
+         bulk = bulk .or. s%bulk_linear > 0 .or. s%bulk_quadratic > 0
+         if (allocated(s%contact_pairs)) walls = walls .or. size(s%contact_pairs) > 0
+         if (allocated(s%boundaries)) boundary = boundary .or. size(s%boundaries) > 0
        end associate
     end do
-    call timer_init(this%timers)
-    do i = 1, n_effects
-       if (this%active(i)) call timer_register(this%timers, trim(effect_names(i)), this%timer_id(i))
-    end do
-  end subroutine effects_decide
-
-  subroutine effects_start(this, id)
-    class(effects_t), intent(inout) :: this
-    integer, intent(in) :: id
-    call timer_start(this%timers, this%timer_id(id))
-  end subroutine effects_start
-
-  subroutine effects_stop(this, id)
-    class(effects_t), intent(inout) :: this
-    integer, intent(in) :: id
-    call timer_stop(this%timers, this%timer_id(id))
-  end subroutine effects_stop
-
-  !> "elements, material, gravity, ..." — the active effects, for the run header.
-  function effects_active_list(this) result(text)
-    class(effects_t), intent(in) :: this
-    character(len=:), allocatable :: text
-    integer :: i
-
-    text = ''
-    do i = 1, n_effects
-       if (.not. this%active(i)) cycle
-       if (len(text) > 0) text = text // ', '
-       text = text // trim(effect_names(i))
-    end do
-  end function effects_active_list
+    call fx%declare(effect_elements, 'elements', active=m%mesh%n_elems > 0)
+    call fx%declare(effect_material, 'material', active=m%mesh%n_elems > 0)
+    call fx%declare(effect_user_field, 'user field', active=user_field)
+    ! one-point elements always need hourglass control
+    call fx%declare(effect_hourglass, 'hourglass', active=m%mesh%n_elems > 0)
+    call fx%declare(effect_bulk_viscosity, 'bulk viscosity', active=bulk)
+    call fx%declare(effect_gravity, 'gravity', active=gravity)
+    call fx%declare(effect_rigid_walls, 'rigid walls', active=walls)
+    call fx%declare(effect_boundary, 'boundary', active=boundary)
+    call fx%declare(effect_assembly, 'assembly', active=.true.)
+    call fx%declare(effect_pressure, 'pressure', active=pressure)
+  end subroutine declare_element_effects
 end module driver_effects

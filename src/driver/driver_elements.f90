@@ -11,8 +11,9 @@ module driver_elements
   use model, only: model_t
   use model_mesh, only: element_cpe4r, element_cax4r
   use driver_solver, only: solver_t, element_block_t
-  use driver_effects, only: effects_t, effect_elements, effect_material, effect_hourglass, &
+  use driver_effects, only: effect_elements, effect_material, effect_hourglass, &
        effect_bulk_viscosity, effect_user_field, effect_assembly
+  use output_effects, only: effects_t
   use driver_temperature, only: element_temperatures
   use material_door, only: vumat_work_t, call_material, vumat_work_init
   use fem_cpe4r, only: cpe4r_increment_kinematics, cpe4r_internal_force, cpe4r_internal_force_bv, &

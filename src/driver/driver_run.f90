@@ -12,7 +12,8 @@ module driver_run
   use parallel_partition, only: partition_t
   use parallel_assembly, only: global_min, global_sum
   use driver_solver, only: solver_t
-  use driver_effects, only: effects_t, effect_gravity, effect_pressure, effect_rigid_walls, effect_boundary
+  use driver_effects, only: effect_gravity, effect_pressure, effect_rigid_walls, effect_boundary
+  use output_effects, only: effects_t
   use driver_setup, only: initial_internal_forces
   use driver_elements, only: element_workspace_t, element_phase
   use driver_loads, only: step_loads_t, prepare_step, apply_prescribed_velocities, &
@@ -492,7 +493,7 @@ contains
     write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
     write (output_unit, '(a,i0,a,i0,a,i0,a,i0,a)') '  model     ', m%mesh%n_nodes, ' nodes, ', m%mesh%n_elems, &
          ' elements, ', m%n_steps, ' step(s), ', part%nranks, ' rank(s)'
-    write (output_unit, '(a)') '  effects   ' // effects%active_list()
+    write (output_unit, '(a)') effects%header_line()
     write (output_unit, '(a)') '  output    ' // output_base // '.h5/.xmf, ' // output_base // &
          '_history.csv'
     flush (output_unit)

@@ -11,7 +11,7 @@ module mpm_musl
   use model, only: model_t
   use model_time_variation, only: variation_factor
   use model_steps, only: bc_velocity
-  use mpm_state, only: mpm_state_t, mpm_effects_t, fx_p2g, fx_grid, fx_g2p, fx_walls, max_over_ranks, det_f
+  use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_walls, max_over_ranks, det_f
   use mpm_grid, only: grid_sum_length, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t
   use mpm_shape, only: block_stencil
@@ -19,7 +19,7 @@ module mpm_musl
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
   use mpm_setup, only: mark_wall_nodes
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
-  use output_timer, only: timer_start, timer_stop
+  use output_effects, only: effects_t
   use parallel_comm, only: comm_sum
   implicit none
   private
@@ -90,11 +90,11 @@ contains
   subroutine musl_transfer(m, st, fx)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    type(mpm_effects_t), intent(inout) :: fx
+    type(effects_t), intent(inout) :: fx
     integer :: ib, k, s
 
     s = st%step
-    call timer_start(fx%timers, fx%id(fx_p2g))
+    call fx%start(fx_p2g)
     call grid_reset_sums(st%g)
     do ib = 1, st%nblocks
        call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
@@ -107,14 +107,14 @@ contains
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) &
             call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k))
     end do
-    call timer_stop(fx%timers, fx%id(fx_p2g))
+    call fx%stop(fx_p2g)
 
     if (fx%active(fx_walls) .and. m%n_rigid_surfaces > 0) call surface_walls_at_new_time(m, st)
-    call timer_start(fx%timers, fx%id(fx_grid))
+    call fx%start(fx_grid)
     call grid_update(st, m%mpm%steps(s)%damping)
-    call timer_stop(fx%timers, fx%id(fx_grid))
+    call fx%stop(fx_grid)
     if (fx%active(fx_walls)) then
-       call timer_start(fx%timers, fx%id(fx_walls))
+       call fx%start(fx_walls)
        do k = 1, size(m%mpm%walls)
           if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
           associate (w => m%mpm%walls(k))
@@ -139,10 +139,10 @@ contains
        end if
        st%wall_impulse = st%wall_impulse + st%dt * st%wall_force
        st%impulse_time = st%impulse_time + st%dt
-       call timer_stop(fx%timers, fx%id(fx_walls))
+       call fx%stop(fx_walls)
     end if
 
-    call timer_start(fx%timers, fx%id(fx_g2p))
+    call fx%start(fx_g2p)
     call grid_clear(st%nd * st%g%nn, st%g%mom)
     do ib = 1, st%nblocks
        call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
@@ -152,9 +152,9 @@ contains
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
     end do
     call remap_velocity(st)
-    call timer_stop(fx%timers, fx%id(fx_g2p))
+    call fx%stop(fx_g2p)
     if (fx%active(fx_walls)) then
-       call timer_start(fx%timers, fx%id(fx_walls))
+       call fx%start(fx_walls)
        do k = 1, size(m%mpm%walls)
           if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
           associate (w => m%mpm%walls(k))
@@ -175,7 +175,7 @@ contains
             end if
           end associate
        end do
-       call timer_stop(fx%timers, fx%id(fx_walls))
+       call fx%stop(fx_walls)
     end if
   end subroutine musl_transfer
 

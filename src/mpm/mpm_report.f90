@@ -5,7 +5,8 @@ module mpm_report
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
   use base_kinds, only: dp
   use model, only: model_t
-  use mpm_state, only: mpm_state_t, mpm_effects_t, n_fx, fx_names, sum_over_ranks, max_over_ranks
+  use mpm_state, only: mpm_state_t, sum_over_ranks, max_over_ranks
+  use output_effects, only: effects_t
   use mpm_output, only: mpm_writer_t, mpm_writer_frame
   use output_history, only: history_t, history_row
   implicit none
@@ -133,22 +134,14 @@ contains
   subroutine header(m, st, fx, base)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(in) :: st
-    type(mpm_effects_t), intent(in) :: fx
+    type(effects_t), intent(in) :: fx
     character(len=*), intent(in) :: base
-    character(len=:), allocatable :: list
-    integer :: k
 
-    list = ''
-    do k = 1, n_fx
-       if (.not. fx%active(k)) cycle
-       if (len(list) > 0) list = list // ', '
-       list = list // trim(fx_names(k))
-    end do
     write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
     write (output_unit, '(a,i0,a,i0,a,i0,a,es10.3,a,a,a,i0,a)') '  mpm       ', st%nd, 'D, ', &
          st%n_initial, ' particles, ', st%g%nn, ' grid nodes, cell ', m%mpm%cell, &
          ', shape ', trim(merge('uGIMP ', 'linear', st%nsup == 3)), ', ', st%nranks, ' rank(s)'
-    write (output_unit, '(a)') '  effects   ' // list
+    write (output_unit, '(a)') fx%header_line()
     write (output_unit, '(a)') '  output    ' // base // '.h5/.xmf (particles), ' // base // '_grid.xmf, ' // &
          base // '_history.csv'
     flush (output_unit)

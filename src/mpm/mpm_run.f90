@@ -20,13 +20,13 @@ module mpm_run
   use base_kinds, only: dp
   use error_report, only: error_t
   use model, only: model_t
-  use mpm_state, only: mpm_state_t, mpm_effects_t, fx_walls, fx_outflow, fx_inflow
+  use mpm_state, only: mpm_state_t, fx_walls, fx_outflow, fx_inflow
   use mpm_musl, only: step_gravity, musl_transfer
   use mpm_stress_update, only: stress_update
   use mpm_flow, only: guard_particles, outflow, inflow
   use mpm_output, only: mpm_writer_t, mpm_writer_frame_count, mpm_field_request_t
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
-  use output_timer, only: timer_start, timer_stop
+  use output_effects, only: effects_t
   use output_collective, only: stop_agreed_error
   use output_history, only: history_t, history_row_count
   implicit none
@@ -41,7 +41,7 @@ contains
   subroutine mpm_increment(m, st, fx)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    type(mpm_effects_t), intent(inout) :: fx
+    type(effects_t), intent(inout) :: fx
     integer :: ib, s
 
     s = st%step
@@ -51,20 +51,20 @@ contains
        call stress_update(m, st, fx, st%blocks(ib))
     end do
     if (fx%active(fx_walls)) then
-       call timer_start(fx%timers, fx%id(fx_walls))
+       call fx%start(fx_walls)
        call guard_particles(m%mpm%walls, st)
-       call timer_stop(fx%timers, fx%id(fx_walls))
+       call fx%stop(fx_walls)
     end if
     if (fx%active(fx_outflow)) then
-       call timer_start(fx%timers, fx%id(fx_outflow))
+       call fx%start(fx_outflow)
        call outflow(st, m%mpm%outflow_level)
-       call timer_stop(fx%timers, fx%id(fx_outflow))
+       call fx%stop(fx_outflow)
     end if
     if (fx%active(fx_inflow)) then
        if (m%mpm%steps(s)%inflow%on) then
-          call timer_start(fx%timers, fx%id(fx_inflow))
+          call fx%start(fx_inflow)
           call inflow(m, st, m%mpm%steps(s)%inflow)
-          call timer_stop(fx%timers, fx%id(fx_inflow))
+          call fx%stop(fx_inflow)
        end if
     end if
   end subroutine mpm_increment

@@ -9,8 +9,9 @@ module mpm_setup
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
   use mpm_scene, only: particle_region_t, region_box, region_polygon
-  use mpm_state, only: mpm_state_t, mpm_effects_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
-       fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_output, n_fx, fx_names
+  use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
+       fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow
+  use output_effects, only: effects_t
   use mpm_grid, only: grid_init
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow
   use mpm_shape, only: stencil_nodes_per_direction
@@ -19,7 +20,6 @@ module mpm_setup
   use mpm_stress_update, only: material_work_init
   use material_door, only: checked_packaging_modulus
   use model_particle_fields, only: particle_initial_field
-  use output_timer, only: timer_init, timer_register
   implicit none
   private
 
@@ -31,7 +31,7 @@ contains
   subroutine mpm_setup_run(m, st, fx)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    type(mpm_effects_t), intent(inout) :: fx
+    type(effects_t), intent(inout) :: fx
     integer :: k, s
 
     call setup_state(m, st)
@@ -117,31 +117,34 @@ contains
     call material_work_init(st, st%work(1), particle_block_size)
   end subroutine setup_state
 
-  !> The effects the scene asks for, and a timer for each one timed apart.
+  !> The MPM's effects, declared into the run's registry: active when the scene asks for them.
+  !> Gravity and damping act inside the P2G/grid loops, VUSDFLD inside the material call: listed,
+  !> not timed apart.
   subroutine setup_effects(m, fx)
     type(model_t), intent(in) :: m
-    type(mpm_effects_t), intent(inout) :: fx
-    integer :: k, s
+    type(effects_t), intent(inout) :: fx
+    logical :: inflow, damping, gravity
+    integer :: s
 
-    fx%active = .false.
-    fx%active([fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, fx_output]) = .true.
-    fx%active(fx_user_field) = any(m%materials(1:m%n_materials)%user_field)
-    fx%active(fx_walls) = size(m%mpm%walls) > 0
-    fx%active(fx_outflow) = m%mpm%outflow
+    inflow = .false.
+    damping = .false.
+    gravity = .false.
     do s = 1, m%n_steps
-       if (m%mpm%steps(s)%inflow%on) fx%active(fx_inflow) = .true.
-       if (m%mpm%steps(s)%damping > 0) fx%active(fx_damping) = .true.
-       if (allocated(m%steps(s)%gravity)) then
-          if (size(m%steps(s)%gravity) > 0) fx%active(fx_gravity) = .true.
-       end if
+       inflow = inflow .or. m%mpm%steps(s)%inflow%on
+       damping = damping .or. m%mpm%steps(s)%damping > 0
+       if (allocated(m%steps(s)%gravity)) gravity = gravity .or. size(m%steps(s)%gravity) > 0
     end do
-    call timer_init(fx%timers)
-    do k = 1, n_fx
-       ! gravity and damping act inside the P2G/grid loops, VUSDFLD inside the material call:
-       ! listed, not timed apart
-       if (fx%active(k) .and. k /= fx_gravity .and. k /= fx_damping .and. k /= fx_user_field) &
-            call timer_register(fx%timers, trim(fx_names(k)), fx%id(k))
-    end do
+    call fx%declare(fx_p2g, 'p2g', active=.true.)
+    call fx%declare(fx_grid, 'grid update', active=.true.)
+    call fx%declare(fx_g2p, 'g2p', active=.true.)
+    call fx%declare(fx_kinematics, 'kinematics', active=.true.)
+    call fx%declare(fx_material, 'material', active=.true.)
+    call fx%declare(fx_user_field, 'user field', active=any(m%materials(1:m%n_materials)%user_field), timed=.false.)
+    call fx%declare(fx_gravity, 'gravity', active=gravity, timed=.false.)
+    call fx%declare(fx_damping, 'damping', active=damping, timed=.false.)
+    call fx%declare(fx_walls, 'walls', active=size(m%mpm%walls) > 0)
+    call fx%declare(fx_outflow, 'outflow', active=m%mpm%outflow)
+    call fx%declare(fx_inflow, 'inflow', active=inflow)
   end subroutine setup_effects
 
   !> A regular lattice of ppc particles per cell and direction (aligned with the grid), kept

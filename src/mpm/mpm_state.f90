@@ -1,8 +1,8 @@
 !> The state of a material-point run that the phases share (mpm_setup, mpm_musl,
 !> mpm_stress_update, mpm_flow, mpm_report, mpm_run): the grid, the rank's particle blocks, the
 !> walls' node lists and mirrors, per-material moduli and VUMAT work sets, the mass and energy
-!> bookkeeping, the clock; and the MPM effects (one switch per effect, a timer for each active
-!> one). Owns the sums over ranks of the run's per-rank values (through src/parallel).
+!> bookkeeping, the clock; and the ids of the MPM's effects (declared by mpm_setup into the
+!> run's registry, output_effects). Owns the sums over ranks of the run's per-rank values (through src/parallel).
 !> Why one type: every phase reads and writes a few of these fields; one argument keeps the
 !> phases' interfaces short and the checkpoint's list of what to save in one place.
 module mpm_state
@@ -14,24 +14,16 @@ module mpm_state
   use mpm_walls, only: wall_nodes_t
   use mpm_mirror, only: mirror_plane_t
   use material_door, only: vumat_work_t
-  use output_timer, only: timer_set_t
+  use output_effects, only: first_technique_effect
   use parallel_comm, only: comm_sum, comm_max
   implicit none
   private
 
-  ! The MPM effects: the same registry idea as driver_effects (one switch from the scene, a
-  ! timer only for what is active, shares in the report); MPM's own list keeps the FEM one intact.
-  integer, parameter, public :: fx_p2g = 1, fx_grid = 2, fx_g2p = 3, fx_kinematics = 4, fx_material = 5, &
-       fx_user_field = 6, fx_gravity = 7, fx_damping = 8, fx_walls = 9, fx_outflow = 10, fx_inflow = 11, &
-       fx_output = 12, n_fx = 12
-  character(len=16), parameter, public :: fx_names(n_fx) = [character(len=16) :: 'p2g', 'grid update', 'g2p', &
-       'kinematics', 'material', 'user field', 'gravity', 'damping', 'walls', 'outflow', 'inflow', 'output']
-
-  type, public :: mpm_effects_t
-     logical :: active(n_fx) = .false.
-     integer :: id(n_fx) = 0
-     type(timer_set_t) :: timers
-  end type mpm_effects_t
+  ! The MPM's effect ids in the run's effects registry (output_effects; output and checkpoint
+  ! are the run skeleton's). A new effect: an id here and its declare line in mpm_setup.
+  integer, parameter, public :: fx_p2g = first_technique_effect, fx_grid = fx_p2g + 1, fx_g2p = fx_p2g + 2, &
+       fx_kinematics = fx_p2g + 3, fx_material = fx_p2g + 4, fx_user_field = fx_p2g + 5, fx_gravity = fx_p2g + 6, &
+       fx_damping = fx_p2g + 7, fx_walls = fx_p2g + 8, fx_outflow = fx_p2g + 9, fx_inflow = fx_p2g + 10
 
   !> Everything the run keeps. Per-rank partial values (sum over ranks when reported) are
   !> marked "rank"; the rest is the same on every rank.

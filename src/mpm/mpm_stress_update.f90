@@ -11,14 +11,14 @@ module mpm_stress_update
   use base_kinds, only: dp
   use error_report, only: raise_error
   use model, only: model_t
-  use mpm_state, only: mpm_state_t, mpm_effects_t, fx_kinematics, fx_material
+  use mpm_state, only: mpm_state_t, fx_kinematics, fx_material
   use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_transfer, only: gather_gradient
   use model_particle_fields, only: particle_temperature
   use material_door, only: vumat_work_t, vumat_work_init, call_material
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
-  use output_timer, only: timer_start, timer_stop
+  use output_effects, only: effects_t
   implicit none
   private
 
@@ -31,7 +31,7 @@ contains
   subroutine stress_update(m, st, fx, b)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
-    type(mpm_effects_t), intent(inout) :: fx
+    type(effects_t), intent(inout) :: fx
     type(particle_block_t), intent(inout) :: b
     integer :: nb, nd, p, iw
     real(dp) :: dt
@@ -40,7 +40,7 @@ contains
     real(dp) :: strain(b%count, st%nc), spin(b%count, st%nshr), strain_corot(b%count, st%nc)
     real(dp) :: rel_spin(b%count, st%nshr), density(b%count), char_length(b%count)
 
-    call timer_start(fx%timers, fx%id(fx_kinematics))
+    call fx%start(fx_kinematics)
     nb = b%count
     nd = st%nd
     dt = st%dt
@@ -86,22 +86,22 @@ contains
     end do
     ! the particle size: CELL/PPC
     char_length = 2 * b%half
-    call timer_stop(fx%timers, fx%id(fx_kinematics))
+    call fx%stop(fx_kinematics)
 
-    call timer_start(fx%timers, fx%id(fx_material))
+    call fx%start(fx_material)
     call call_material(m%materials(b%material), nb, st%nc, st%nshr, b%number, st%step_time + dt, &
          st%total_time + dt, dt, char_length, density, strain_corot, rel_spin, st%work(iw)%stretch_old, &
          st%work(iw)%stretch_new, st%work(iw)%defgrad_old, st%work(iw)%defgrad_new, &
          b%log_strain, b%stress, b%state, b%field, b%e_int, b%e_inel, st%work(iw))
-    call timer_stop(fx%timers, fx%id(fx_material))
+    call fx%stop(fx_material)
 
-    call timer_start(fx%timers, fx%id(fx_kinematics))
+    call fx%start(fx_kinematics)
     ! LE: what vgetvrm hands the next VUSDFLD and what the output shows
     b%log_strain = b%log_strain + strain_corot
     b%f = f_new
     b%rot = r_new
     call to_global(nb, nd, st%nc, r_new, b%stress, b%stress_global)
-    call timer_stop(fx%timers, fx%id(fx_kinematics))
+    call fx%stop(fx_kinematics)
   end subroutine stress_update
 
   !> F_{n+1} = (I + L Δt) F_n, F_{n+½} = (I + ½ L Δt) F_n, the strain increment sym(L)Δt

@@ -2,13 +2,12 @@
 !> run skeleton: element_technique_t holds the solver's state of this rank and wraps the
 !> driver's phase routines; run_loop drives it.
 module run_element
-  use, intrinsic :: iso_fortran_env, only: output_unit
   use base_kinds, only: dp
   use error_report, only: error_t
   use model, only: model_t
   use parallel_partition, only: partition_t, partition_model
   use driver_solver, only: solver_t
-  use driver_effects, only: effects_t, effect_output, effect_checkpoint, effect_user_field
+  use driver_effects, only: declare_element_effects, effect_user_field
   use driver_setup, only: setup_solver
   use driver_elements, only: element_workspace_t, element_workspace_init
   use driver_loads, only: step_loads_t
@@ -20,23 +19,20 @@ module run_element
   use driver_run, only: start_step, proposed_increment, one_increment, strain_energy_scale, print_header, &
        print_summary
   use output_collective, only: stop_agreed_error
-  use output_timer, only: timer_report
-  use run_technique, only: technique_t, run_options_t, run_clock_t, phase_output, phase_checkpoint
+  use run_technique, only: technique_t, run_options_t, run_clock_t
   implicit none
   private
 
   type, public, extends(technique_t) :: element_technique_t
      type(partition_t) :: part
      type(solver_t) :: solver
-     type(effects_t) :: effects
      type(element_workspace_t) :: ew
      type(step_loads_t) :: loads
      type(step_pressures_t) :: pressures
      type(run_output_t) :: out
    contains
      procedure :: setup, open_outputs, load, header, step_start, stable_increment, increment, frame, history, &
-          save, stop_condition, step_end, clock, progress_note, phase_start, phase_stop, close_outputs, summary, &
-          timing_report
+          save, stop_condition, step_end, clock, progress_note, close_outputs, summary
   end type element_technique_t
 
 contains
@@ -47,7 +43,7 @@ contains
     integer :: i, max_state, max_field
 
     call partition_model(m, this%comm, this%part)
-    call this%effects%decide(m)
+    call declare_element_effects(m, this%effects)
     call setup_solver(m, this%part, this%solver, this%effects%active(effect_user_field))
     max_state = 1
     max_field = 1
@@ -180,26 +176,6 @@ contains
     text = ''
   end function progress_note
 
-  !> Output and checkpoints have effects of their own (a checkpoint only with *RESTART, WRITE:
-  !> the checkpoint of a --stop-after alone is not timed, as before).
-  subroutine phase_start(this, phase)
-    class(element_technique_t), intent(inout) :: this
-    integer, intent(in) :: phase
-
-    if (phase == phase_output) call this%effects%start(effect_output)
-    if (phase == phase_checkpoint .and. this%effects%active(effect_checkpoint)) &
-         call this%effects%start(effect_checkpoint)
-  end subroutine phase_start
-
-  subroutine phase_stop(this, phase)
-    class(element_technique_t), intent(inout) :: this
-    integer, intent(in) :: phase
-
-    if (phase == phase_output) call this%effects%stop(effect_output)
-    if (phase == phase_checkpoint .and. this%effects%active(effect_checkpoint)) &
-         call this%effects%stop(effect_checkpoint)
-  end subroutine phase_stop
-
   subroutine close_outputs(this)
     class(element_technique_t), intent(inout) :: this
 
@@ -213,10 +189,4 @@ contains
     if (m%n_rigid_surfaces > 0) call sum_over_ranks(this%solver, this%solver%wall_force)
     if (this%rank == 0) call print_summary(m, this%solver)
   end subroutine summary
-
-  subroutine timing_report(this)
-    class(element_technique_t), intent(inout) :: this
-
-    call timer_report(this%effects%timers, output_unit, this%comm)
-  end subroutine timing_report
 end module run_element

@@ -7,11 +7,19 @@
 !>   - the *STOP CONDITION evaluation (every stop_check_stride increments and at the step's end);
 !>   - checkpoints (*RESTART, WRITE intervals, --stop-after) and the restart (--restart);
 !>   - the progress line, the header's restart line and the end report's first lines;
-!>   - the wall time of output and checkpoints in the technique's effects registry.
+!>   - the run's effects registry (technique_t%effects, output_effects): its clock, the output and
+!>     checkpoint effects after the technique's own, their wall time, the timing table;
+!>   - the outputs of a --stop-after stop: one rule for both techniques, below.
 !> The order within an increment: the increment, its scheduled frame and row, the checkpoint,
-!> (MPM only: the extra row and frame of a --stop-after stop), the progress line, the stop
-!> condition. The checkpoint follows the increment's own outputs and precedes a stop's extra
-!> ones, so a restart drops those (it keeps the frames and rows the checkpoint counted).
+!> the extra row and frame of a --stop-after stop, the progress line, the stop condition. The
+!> checkpoint follows the increment's own outputs and precedes a stop's extra ones, so a restart
+!> drops those (it keeps the frames and rows the checkpoint counted).
+!>
+!> The --stop-after rule: the run writes a history row and a field frame of the stopping
+!> increment unless the schedule wrote them there already. Why: a user who stops a run early
+!> wants its last state, as a *STOP CONDITION stop and the end of every step (Abaqus writes the
+!> last increment of a step whatever the output interval) give it; the stop's outputs are
+!> made after its checkpoint, so a --restart continues as if there had been no stop.
 module run_loop
   use, intrinsic :: iso_fortran_env, only: output_unit
   use mpi_f08, only: MPI_Comm
@@ -20,7 +28,8 @@ module run_loop
   use output_schedule, only: output_schedule_t, field_schedule, history_schedule, schedule_due, &
        schedule_advance, schedule_resume
   use parallel_comm, only: comm_rank, comm_size
-  use run_technique, only: technique_t, run_options_t, run_clock_t, phase_output, phase_checkpoint
+  use output_effects, only: effect_output, effect_checkpoint
+  use run_technique, only: technique_t, run_options_t, run_clock_t
   use run_progress, only: progress_t, progress_begin, progress_line, progress_step_done, progress_seconds
   implicit none
   private
@@ -48,7 +57,11 @@ contains
     tech%comm = comm
     tech%rank = comm_rank(comm)
     tech%nranks = comm_size(comm)
+    call tech%effects%init()
     call tech%setup(m)
+    call tech%effects%declare(effect_output, 'output', active=.true.)
+    call tech%effects%declare(effect_checkpoint, 'checkpoint', &
+         active=any(m%steps(1:m%n_steps)%restart_write) .or. opts%stop_after > 0)
     resumed = opts%restart
     if (resumed) then
        call tech%load(m, opts)
@@ -116,7 +129,7 @@ contains
        write (output_unit, '(a,i0,a,es12.5)') 'bulkflow: done, ', c%increment, ' increments, t = ', c%total_time
     end if
     call tech%summary(m)
-    call tech%timing_report()
+    call tech%effects%report(output_unit, comm)
   end subroutine run_scene
 
   !> The increment: the technique's Δt cut at the step's end and at a listed output time.
@@ -153,7 +166,7 @@ contains
   end subroutine cut_increment
 
   !> After an increment: its scheduled frame and row, the checkpoint (due or a --stop-after
-  !> stop), and the MPM's extra row and frame of a stop.
+  !> stop), and the row and frame of a --stop-after stop that the schedule did not write.
   subroutine increment_end(tech, m, opts, istep, c, field, history, stop_now)
     class(technique_t), intent(inout) :: tech
     type(model_t), intent(in) :: m
@@ -166,15 +179,15 @@ contains
 
     call scheduled_outputs(tech, m, istep, c, field, history, frame_due, row_due)
     if (stop_now .or. checkpoint_due(m, istep, c%step_time, c%dt)) then
-       call tech%phase_start(phase_checkpoint)
+       call tech%effects%start(effect_checkpoint)
        call tech%save(m, opts)
-       call tech%phase_stop(phase_checkpoint)
+       call tech%effects%stop(effect_checkpoint)
     end if
-    if (stop_now .and. tech%outputs_at_stop) then
-       call tech%phase_start(phase_output)
+    if (stop_now) then
+       call tech%effects%start(effect_output)
        if (.not. row_due) call tech%history(m, istep)
        if (.not. frame_due) call tech%frame(m, istep)
-       call tech%phase_stop(phase_output)
+       call tech%effects%stop(effect_output)
     end if
   end subroutine increment_end
 
@@ -189,7 +202,7 @@ contains
     logical, intent(out), optional :: frame_due, row_due
     logical :: fdue, rdue
 
-    call tech%phase_start(phase_output)
+    call tech%effects%start(effect_output)
     fdue = schedule_due(field, c%step_time, c%step_increment, c%dt)
     rdue = schedule_due(history, c%step_time, c%step_increment, c%dt)
     if (fdue) then
@@ -200,7 +213,7 @@ contains
        call tech%history(m, istep)
        call schedule_advance(history, c%step_time)
     end if
-    call tech%phase_stop(phase_output)
+    call tech%effects%stop(effect_output)
     if (present(frame_due)) frame_due = fdue
     if (present(row_due)) row_due = rdue
   end subroutine scheduled_outputs

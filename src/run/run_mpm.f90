@@ -2,10 +2,9 @@
 !> skeleton: mpm_technique_t holds the run state of this rank, the particle/grid writer and the
 !> history, and wraps the MPM's phase routines; run_loop drives it.
 module run_mpm
-  use, intrinsic :: iso_fortran_env, only: output_unit
   use base_kinds, only: dp
   use model, only: model_t
-  use mpm_state, only: mpm_state_t, mpm_effects_t, fx_output
+  use mpm_state, only: mpm_state_t
   use mpm_setup, only: mpm_setup_run, mark_wall_nodes
   use mpm_musl, only: stable_increment_of => stable_increment
   use mpm_report, only: report_header => header, report_summary => summary, history_columns, measure, &
@@ -13,14 +12,12 @@ module run_mpm
   use mpm_output, only: mpm_writer_t, mpm_writer_open, mpm_writer_close, mpm_field_request_t, mpm_field_requests
   use mpm_run, only: mpm_increment, mpm_save, mpm_resume
   use output_history, only: history_t, history_open, history_close
-  use output_timer, only: timer_start, timer_stop, timer_report
   use run_technique, only: technique_t, run_options_t, run_clock_t
   implicit none
   private
 
   type, public, extends(technique_t) :: mpm_technique_t
      type(mpm_state_t) :: st
-     type(mpm_effects_t) :: fx
      type(mpm_writer_t) :: wr                      !< particle and grid frames (every rank its blocks)
      type(history_t) :: hist
      character(len=32), allocatable :: columns(:)  !< history columns
@@ -29,8 +26,7 @@ module run_mpm
      real(dp) :: last_row_time = 0, last_row_out = 0
    contains
      procedure :: setup, open_outputs, load, header, step_start, stable_increment, increment, frame, history, &
-          save, stop_condition, step_end, clock, progress_note, phase_start, phase_stop, close_outputs, summary, &
-          timing_report
+          save, stop_condition, step_end, clock, progress_note, close_outputs, summary
   end type mpm_technique_t
 
 contains
@@ -39,12 +35,10 @@ contains
     class(mpm_technique_t), intent(inout) :: this
     type(model_t), intent(in) :: m
 
-    ! a --stop-after stop writes the row and frame of its increment (mpm_checkpoint's rule)
-    this%outputs_at_stop = .true.
     this%st%comm = this%comm
     this%st%rank = this%rank
     this%st%nranks = this%nranks
-    call mpm_setup_run(m, this%st, this%fx)
+    call mpm_setup_run(m, this%st, this%effects)
     this%fields = mpm_field_requests(m)
     call history_columns(m, this%columns)
   end subroutine setup
@@ -75,7 +69,7 @@ contains
     type(model_t), intent(in) :: m
     type(run_options_t), intent(in) :: opts
 
-    if (this%rank == 0) call report_header(m, this%st, this%fx, opts%output_base)
+    if (this%rank == 0) call report_header(m, this%st, this%effects, opts%output_base)
   end subroutine header
 
   !> The step's clock at its start (unless resumed) and the grid nodes of its walls.
@@ -114,7 +108,7 @@ contains
     associate (st => this%st)
       st%dt = dt
       st%particle_steps = st%particle_steps + sum(st%blocks(1:st%nblocks)%count)
-      call mpm_increment(m, st, this%fx)
+      call mpm_increment(m, st, this%effects)
       st%step_time = t_new
       st%total_time = st%total_time + st%dt
       st%increment = st%increment + 1
@@ -182,21 +176,6 @@ contains
     text = trim(buf)
   end function progress_note
 
-  !> Output and checkpoints are timed together as the MPM's output effect.
-  subroutine phase_start(this, phase)
-    class(mpm_technique_t), intent(inout) :: this
-    integer, intent(in) :: phase
-
-    call timer_start(this%fx%timers, this%fx%id(fx_output))
-  end subroutine phase_start
-
-  subroutine phase_stop(this, phase)
-    class(mpm_technique_t), intent(inout) :: this
-    integer, intent(in) :: phase
-
-    call timer_stop(this%fx%timers, this%fx%id(fx_output))
-  end subroutine phase_stop
-
   subroutine close_outputs(this)
     class(mpm_technique_t), intent(inout) :: this
 
@@ -211,10 +190,4 @@ contains
     this%st%loop_seconds = this%loop_seconds
     call report_summary(m, this%st)
   end subroutine summary
-
-  subroutine timing_report(this)
-    class(mpm_technique_t), intent(inout) :: this
-
-    call timer_report(this%fx%timers, output_unit, this%comm)
-  end subroutine timing_report
 end module run_mpm

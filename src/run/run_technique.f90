@@ -11,6 +11,7 @@ module run_technique
   use mpi_f08, only: MPI_Comm
   use base_kinds, only: dp
   use model, only: model_t
+  use output_effects, only: effects_t
   implicit none
   private
 
@@ -30,15 +31,12 @@ module run_technique
      real(dp) :: step_time = 0, total_time = 0, dt = 0
   end type run_clock_t
 
-  !> Phases the loop times in the technique's effects registry.
-  integer, parameter, public :: phase_output = 1, phase_checkpoint = 2
-
   type, abstract, public :: technique_t
      type(MPI_Comm) :: comm
      integer :: rank = 0, nranks = 1
-     !> A --stop-after stop writes a history row and a frame of the stopping increment when the
-     !> schedule has none there (the MPM's rule; the element solver writes none: see run_loop).
-     logical :: outputs_at_stop = .false.
+     !> The run's effects registry: the technique declares its own effects in setup, the loop
+     !> adds output and checkpoint, times them and prints the table at the end.
+     type(effects_t) :: effects
      real(dp) :: loop_seconds = 0      !< wall time of the step loop (set by run_loop before summary)
    contains
      procedure(setup_i), deferred :: setup
@@ -55,15 +53,13 @@ module run_technique
      procedure(write_i), deferred :: step_end
      procedure(clock_i), deferred :: clock
      procedure(note_i), deferred :: progress_note
-     procedure(phase_i), deferred :: phase_start
-     procedure(phase_i), deferred :: phase_stop
      procedure(close_i), deferred :: close_outputs
      procedure(summary_i), deferred :: summary
-     procedure(close_i), deferred :: timing_report
   end type technique_t
 
   abstract interface
-     !> Once before the first increment: partition, effects registry, state (collective).
+     !> Once before the first increment: partition, the technique's effects (declared into
+     !> this%effects, whose clock the loop has started), state (collective).
      subroutine setup_i(this, m)
        import :: technique_t, model_t
        class(technique_t), intent(inout) :: this
@@ -147,13 +143,7 @@ module run_technique
        character(len=:), allocatable :: text
      end function note_i
 
-     subroutine phase_i(this, phase)
-       import :: technique_t
-       class(technique_t), intent(inout) :: this
-       integer, intent(in) :: phase
-     end subroutine phase_i
-
-     !> close_outputs: close the files. timing_report: the effects' timing table (collective).
+     !> Close the output files.
      subroutine close_i(this)
        import :: technique_t
        class(technique_t), intent(inout) :: this

@@ -73,11 +73,11 @@ def expected(kind):
     return out
 
 
-def run(exe, scene, base):
-    r = subprocess.run([exe, str(scene), '--output', str(base), '--quiet'], capture_output=True, text=True)
+def run(exe, scene, base, *extra):
+    r = subprocess.run([exe, str(scene), '--output', str(base), '--quiet', *extra], capture_output=True, text=True)
     if r.returncode != 0:
         print(r.stdout, r.stderr)
-        sys.exit(f'FAIL: {scene} exit status {r.returncode}')
+        sys.exit(f'FAIL: {scene} {" ".join(extra)}: exit status {r.returncode}')
 
 
 def frames(h5, group):
