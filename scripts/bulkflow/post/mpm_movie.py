@@ -29,16 +29,16 @@ from bulkflow.post.run_output import read_scene_facts  # noqa: E402
 
 
 def particle_frames(h5_path):
-    """[(step, total_time, xy (n, 2), speed (n,))] of every particle frame, in order."""
+    """[(step, total_time, xy (n, 2), speed (n,), side (n,))] of every particle frame, in order;
+    side = sqrt of the particle's current volume (area per unit depth)."""
     out = []
     with h5py.File(h5_path, "r") as f:
         for key in sorted(f["particles"].keys()):
             g = f["particles"][key]
             x, v = g["coordinates"][:], g["V"][:]
             out.append((int(g.attrs["step"][0]), float(g.attrs["total_time"][0]), x[:, :2],
-                        np.linalg.norm(v[:, :2], axis=1)))
-        spacing = float(np.median(np.sqrt(f["particles"][sorted(f["particles"].keys())[0]]["volume"][:])))
-    return out, spacing
+                        np.linalg.norm(v[:, :2], axis=1), np.sqrt(g["volume"][:])))
+    return out
 
 
 def _mirror(xy, axis_x):
@@ -73,16 +73,16 @@ def _segments(scene, facts, step, axis_x):
 
 def make_movie(base, scene_path, output, fps=10, mirror=True, vmax=None, dpi=80, title=None):
     """Write the animation; returns dict(frames, vmax, particles (last frame), output)."""
-    frames, spacing = particle_frames(f"{base}.h5")
+    frames = particle_frames(f"{base}.h5")
     if not frames:
         raise SystemExit(f"{base}.h5: no particle frames")
     scene = read_mpm_scene(scene_path)
     facts = read_scene_facts(scene_path)
     axis_x = scene.symmetry_x() if mirror else None
     if vmax is None:
-        vmax = float(np.percentile(np.concatenate([s for *_, s in frames]), 99.5)) or 1.0
+        vmax = float(np.percentile(np.concatenate([f[3] for f in frames]), 99.5)) or 1.0
     # the view: every wall and every particle position of the run
-    pts = np.vstack([_mirror(xy, axis_x) for _, _, xy, _ in frames] +
+    pts = np.vstack([_mirror(f[2], axis_x) for f in frames] +
                     [p.T for p, _ in _segments(scene, facts, frames[0][0], axis_x)])
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     if scene.outflow is not None:
@@ -97,34 +97,37 @@ def make_movie(base, scene_path, output, fps=10, mirror=True, vmax=None, dpi=80,
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    fig.tight_layout()
-    # marker area: one particle spacing across, in points
-    px_per_m = ax.transData.transform([1.0, 0.0])[0] - ax.transData.transform([0.0, 0.0])[0]
-    size = (spacing * px_per_m * 72.0 / dpi) ** 2
-    step0, t0, xy0, s0 = frames[0]
-    sc = ax.scatter(*_mirror(xy0, axis_x).T, c=np.tile(s0, 2 if axis_x is not None else 1), s=size,
+    copies = 2 if axis_x is not None else 1
+    sc = ax.scatter(*_mirror(frames[0][2], axis_x).T, c=np.tile(frames[0][3], copies), s=1.0,
                     cmap="viridis", vmin=0.0, vmax=vmax, marker="s", linewidths=0)
     fig.colorbar(sc, ax=ax, shrink=0.7, label="particle speed |v| [m/s]")
+    fig.suptitle(title or facts.heading, fontsize=9)
+    fig.tight_layout()
+    # markers: squares of the particle's own area (in points, once the layout is final), a little
+    # more so that rounding to pixels leaves no gaps where the particles tile the space
+    pt_per_m = 1.15 * (ax.transData.transform([1.0, 0.0])[0] - ax.transData.transform([0.0, 0.0])[0]) * 72.0 / dpi
     lines = []
     if scene.outflow is not None:
         ax.axhline(scene.outflow, c="0.5", lw=0.8, ls=":")
         ax.annotate("outflow level", (hi[0], scene.outflow), xytext=(-4, 3), textcoords="offset points",
                     ha="right", fontsize=8, color="0.4")
-    label = ax.set_title("")
-    heading = title or facts.heading
+    label = ax.text(0.02, 0.98, "", transform=ax.transAxes, va="top", fontsize=10)
 
     def draw(i):
-        step, t, xy, speed = frames[i]
+        step, t, xy, speed, side = frames[i]
         sc.set_offsets(_mirror(xy, axis_x))
-        sc.set_array(np.tile(speed, 2) if axis_x is not None else speed)
+        sc.set_array(np.tile(speed, copies))
+        sc.set_sizes(np.tile((side * pt_per_m) ** 2, copies))
         for ln in lines:
             ln.remove()
         lines.clear()
         for p, style in _segments(scene, facts, step, axis_x):
             lines.extend(ax.plot(p[0], p[1], **style))
-        opened = any(not w.active(step) for w in scene.outlets())
-        label.set_text(f"{heading[:60]}\nt = {t:5.2f} s, {scene.step_name(step)}"
-                       + (" (outlet open)" if opened else ""))
+        outlet = ""
+        if scene.outlets():
+            opened = any(not w.active(step) for w in scene.outlets())
+            outlet = " (outlet open)" if opened else " (outlet closed)"
+        label.set_text(f"t = {t:4.2f} s, step {scene.step_name(step)}{outlet}")
         return [sc, label, *lines]
 
     anim = animation.FuncAnimation(fig, draw, frames=len(frames), blit=False)
