@@ -2,13 +2,13 @@
 the scene's walls drawn (a wall that a later step deletes, the outlet, solid while it is closed and
 dashed once open), the outflow level dotted.
 
-    bulkflow-mpm-movie BASE --scene SCENE.inp -o out.gif [--fps 10] [--no-mirror] [--vmax V]
+    bulkflow-mpm-movie BASE --scene SCENE.inp -o out.gif [--fps 10] [--no-mirror] [--vmax V] [--linear]
 
 GIF through matplotlib's PillowWriter (Pillow comes with matplotlib); a name ending in .mp4 uses
 ffmpeg, which must be installed. A half model (a vertical symmetry wall) is mirrored about its
 axis to show the whole hopper, unless --no-mirror. The colour scale runs from 0 to --vmax (default:
 the 99.5th percentile of |v| over all frames, so a few fast particles below the outlet do not wash
-out the rest). Frames: /particles/NNNNNN of BASE.h5 (coordinates, V, volume; attributes step,
+out the rest), logarithmic over three decades below it (--linear: from 0). Frames: /particles/NNNNNN of BASE.h5 (coordinates, V, volume; attributes step,
 total_time; src/mpm/README.md "Outputs").
 """
 from __future__ import annotations
@@ -22,10 +22,14 @@ matplotlib.use("Agg")
 import h5py  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib import animation  # noqa: E402
+from matplotlib import animation, colors  # noqa: E402
 
 from bulkflow.post.mpm_scene import read_mpm_scene  # noqa: E402
 from bulkflow.post.run_output import read_scene_facts  # noqa: E402
+
+# The log colour scale spans vmax/1000 .. vmax: the slow creep along the walls (mass flow) and the
+# stagnant zones (funnel flow) stay apart, where a linear scale shows only the fast core.
+LOG_DECADES_SHOWN = 1000.0
 
 
 def particle_frames(h5_path):
@@ -49,15 +53,24 @@ def _mirror(xy, axis_x):
     return np.vstack([xy, m])
 
 
+def _clip(p, axis_x):
+    """The part of segment p (2, 2) on the model's side of the axis x = axis_x (x >= axis_x)."""
+    if axis_x is None or (p[:, 0] >= axis_x).all() or (p[:, 0] < axis_x).all():
+        return p
+    a, b = p if p[0, 0] < axis_x else p[::-1]
+    s = (axis_x - a[0]) / (b[0] - a[0])
+    return np.array([[axis_x, a[1] + s * (b[1] - a[1])], b])
+
+
 def _segments(scene, facts, step, axis_x):
     """(points (2, k), style) of every wall to draw in `step`, mirrored about the axis."""
     out = []
     for w in scene.walls:
         if w.kind == "SYMMETRY":
             continue
-        pts = np.array([w.p0, w.p1]).T
+        pts = _clip(np.array([w.p0, w.p1], dtype=float), axis_x).T
         if w.last_step is not None:          # the closable outlet
-            style = dict(c="k", lw=2.5) if w.active(step) else dict(c="crimson", lw=1.5, ls="--")
+            style = dict(c="k", lw=2.5) if w.active(step) else dict(c="crimson", lw=2, ls="--")
         elif w.active(step):
             style = dict(c="k", lw=2.5)
         else:
@@ -71,7 +84,7 @@ def _segments(scene, facts, step, axis_x):
     return out
 
 
-def make_movie(base, scene_path, output, fps=10, mirror=True, vmax=None, dpi=80, title=None):
+def make_movie(base, scene_path, output, fps=10, mirror=True, vmax=None, dpi=80, title=None, linear=False):
     """Write the animation; returns dict(frames, vmax, particles (last frame), output)."""
     frames = particle_frames(f"{base}.h5")
     if not frames:
@@ -98,8 +111,10 @@ def make_movie(base, scene_path, output, fps=10, mirror=True, vmax=None, dpi=80,
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     copies = 2 if axis_x is not None else 1
+    norm = (colors.Normalize(0.0, vmax) if linear else
+            colors.LogNorm(vmax / LOG_DECADES_SHOWN, vmax, clip=True))
     sc = ax.scatter(*_mirror(frames[0][2], axis_x).T, c=np.tile(frames[0][3], copies), s=1.0,
-                    cmap="viridis", vmin=0.0, vmax=vmax, marker="s", linewidths=0)
+                    cmap="viridis", norm=norm, marker="s", linewidths=0)
     fig.colorbar(sc, ax=ax, shrink=0.7, label="particle speed |v| [m/s]")
     fig.suptitle(title or facts.heading, fontsize=9)
     fig.tight_layout()
@@ -149,8 +164,9 @@ def main(argv=None):
     p.add_argument("--dpi", type=int, default=80)
     p.add_argument("--vmax", type=float, help="top of the colour scale [m/s]")
     p.add_argument("--no-mirror", action="store_true", help="draw the half model only")
+    p.add_argument("--linear", action="store_true", help="linear colour scale from 0 (default: log, 3 decades)")
     a = p.parse_args(argv)
-    r = make_movie(a.base, a.scene, a.output, a.fps, not a.no_mirror, a.vmax, a.dpi)
+    r = make_movie(a.base, a.scene, a.output, a.fps, not a.no_mirror, a.vmax, a.dpi, linear=a.linear)
     print(f"  animation: {r['output']} ({r['frames']} frames, |v| colour scale 0..{r['vmax']:.2f} m/s)")
     return 0
 
