@@ -101,10 +101,15 @@ def digest_lines(d):
                f"{100 * d['trend_per_s']:+.1f} %/s" if math.isfinite(d["spread"]) else "too short for windows")
     if not d["steady"]:
         plateau += f"; NOT steady: a window departs by > 10 % at {d['t_ss']:.2f} s after opening"
-    line1 = (f"steady MDR {d['mdr']:.0f} kg/s/m (full hopper, {d['mdr_from']:g}–{d['discharge']:.2f} s after "
-             f"opening; {plateau}); Beverloo {d['beverloo']:.0f}, Rose–Tanaka {d['rose_tanaka']:.0f} kg/s/m "
-             f"(b {d['outlet']:g} m, θ {d['theta']:.0f}°, ρ_i {d['rho_fill']:.0f} kg/m³, C {d['C']:g}, d = 0): "
-             f"MPM/Beverloo {d['ratio_beverloo']:.2f}, MPM/Rose–Tanaka {d['ratio_rose_tanaka']:.2f}")
+    if not math.isfinite(d["mdr"]):
+        line1 = (f"steady MDR: not measured (the discharge lasted {d['discharge']:.2f} s; the steady rate is "
+                 f"taken from {d['mdr_from']:g} s after opening, --skip); Beverloo {d['beverloo']:.0f}, "
+                 f"Rose–Tanaka {d['rose_tanaka']:.0f} kg/s/m")
+    else:
+        line1 = (f"steady MDR {d['mdr']:.0f} kg/s/m (full hopper, {d['mdr_from']:g}–{d['discharge']:.2f} s after "
+                 f"opening; {plateau}); Beverloo {d['beverloo']:.0f}, Rose–Tanaka {d['rose_tanaka']:.0f} kg/s/m "
+                 f"(b {d['outlet']:g} m, θ {d['theta']:.0f}°, ρ_i {d['rho_fill']:.0f} kg/m³, C {d['C']:g}, d = 0): "
+                 f"MPM/Beverloo {d['ratio_beverloo']:.2f}, MPM/Rose–Tanaka {d['ratio_rose_tanaka']:.2f}")
     last = " ".join(f"{m:.2f}" for m in d["mfi_last_frames"])
     line2 = (f"flow mode: {d['flow_mode']} flow, MFI {d['mfi']:.2f} {'>' if d['mfi'] > MFI_THRESHOLD else '≤'} "
              f"{MFI_THRESHOLD:g} (wall/axis vertical velocity, {d['mfi_wall']}/{d['mfi_axis']} particles, frame at "
