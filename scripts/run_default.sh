@@ -9,9 +9,17 @@
 #      energy balance) and write a picture: out/default/wedge_hopper.png (deformed mesh coloured
 #      by vertical stress, walls, energies and wall loads against time);
 #   4. the material-point job (the previous default): drained triaxial test of a Mohr-Coulomb sand
-#      with bulkflow-matpoint, plot out/default/triaxial_mc.png.
-# Outputs go to out/default/. Environment: NP (ranks; default nproc), SCENE (another .inp),
-# SKIP_MATPOINT=1 (main job only).
+#      with bulkflow-matpoint, plot out/default/triaxial_mc.png;
+#   5. the MPM job: the same hopper (thesis Table 4.2 material) as a material-point scene,
+#      inputs/demo/wedge_hopper_mpm_discharge.inp (cell 0.05 m, 4756 particles): 1 s fill with the
+#      outlet closed, then 2 s of discharge; the solver's wall time and the load average are printed.
+#      Then out/default/wedge_hopper_mpm_discharge.gif (particles coloured by speed, walls, outlet;
+#      bulkflow-mpm-movie), ..._mdr.png (discharge rate against time beside Beverloo and
+#      Rose-Tanaka; bulkflow-mpm-digest, figures also in ..._digest.json) and, last, a two-line
+#      digest: the steady discharge rate with the theories' values and ratios, and the flow mode.
+# Outputs go to out/default/. Environment: NP (ranks; default nproc), SCENE (another element .inp),
+# SKIP_MATPOINT=1 (no material-point job), SKIP_MPM=1 (no MPM job), MPM_SCENE (another MPM
+# hopper .inp for step 5).
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 out="$repo/out/default"
@@ -47,4 +55,22 @@ if [ "${SKIP_MATPOINT:-0}" != 1 ]; then
   "$repo/build/bin/bulkflow-matpoint" "$repo/inputs/matpoint/triaxial_mc.inp" -o "$out/triaxial_mc.csv"
   "$repo/.venv/bin/bulkflow-matpoint-plot" "$out/triaxial_mc.csv" -o "$out/triaxial_mc.png"
   echo "  plot: $out/triaxial_mc.png"
+fi
+
+if [ "${SKIP_MPM:-0}" != 1 ]; then
+  mpm_scene=${MPM_SCENE:-$repo/inputs/demo/wedge_hopper_mpm_discharge.inp}
+  mpm_name=$(basename "$mpm_scene" .inp)
+  echo "== MPM job: fill and discharge of the hopper, $mpm_scene on $np rank(s) (about a minute on 2 idle cores)"
+  load_before=$(cut -d' ' -f1-3 /proc/loadavg)
+  start=$(date +%s%N)
+  "${mpi[@]}" "$repo/build/bin/bulkflow" "$mpm_scene" --output "$out/$mpm_name" --quiet
+  end=$(date +%s%N)
+  ms=$(( (end - start) / 1000000 ))
+  printf '  solver wall time %d.%d s (load average before %s, after %s)\n' $((ms / 1000)) $((ms % 1000 / 100)) \
+    "$load_before" "$(cut -d' ' -f1-3 /proc/loadavg)"
+  "$py" -m bulkflow.post.mpm_movie "$out/$mpm_name" --scene "$mpm_scene" -o "$out/$mpm_name.gif"
+  echo "  particles for ParaView: $out/$mpm_name.xmf"
+  echo "== MPM digest ($out/${mpm_name}_mdr.png, $out/${mpm_name}_digest.json)"
+  "$py" -m bulkflow.post.mpm_digest "$out/$mpm_name" --scene "$mpm_scene" -o "$out/${mpm_name}_mdr.png" \
+    --json "$out/${mpm_name}_digest.json"
 fi
