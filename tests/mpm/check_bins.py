@@ -6,7 +6,8 @@ right wall), both written by bulkflow-make-bin (inputs/mpm/bin_small_*_2d.inp), 
 - mass balance of each run exact: initial particles + 0 in = out + remaining (counts), the
   discharged mass is n_out times the particle mass and M0 - MASS_OUT - MASS is round-off (1e-12 M0);
 - the eccentric bin discharges faster than the concentric one (full-bin MDR per metre, regression
-  of the discharged mass from `--skip` s after opening to the end), as in the thesis's experiments
+  of the discharged mass from `--skip` s after opening to the end; and the discharged mass at the
+  end), as in the thesis's experiments
   and Maiti et al.'s: the sand slides past the 7 deg wall instead of shearing against sand at 34 deg.
 
     check_bins.py <concentric.inp> <eccentric.inp> --bulkflow <exe> --workdir <dir>
@@ -79,6 +80,8 @@ def main():
     mdr_e = rate(hist_e, a.skip)
     check(mdr_e > mdr_c, f"eccentric discharges faster: MDR {mdr_e:.4g} > concentric {mdr_c:.4g} kg/s/m "
           f"(ratio {mdr_e / mdr_c:.3f})")
+    out_c, out_e = 2.0 * hist_c["MASS_OUT"][-1], hist_e["MASS_OUT"][-1]
+    check(out_e > out_c, f"eccentric has discharged more at the end: {out_e:.4g} > concentric {out_c:.4g} kg/m")
     if FAILED:
         sys.exit(f"{len(FAILED)} check(s) failed")
     print("all bin checks passed")

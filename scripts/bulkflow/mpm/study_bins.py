@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from . import bin_analysis as BA
-from .bin_scene import D_PARTICLE, OUTLET, RHO_I
+from .bin_scene import D_PARTICLE, OUTLET, RHO_I, YOUNG
 
 CASES = (("concentric", "NDNS"), ("concentric", "DS"), ("eccentric", "NDNS"), ("eccentric", "DS"))
 VARIANTS = ((("eccentric", "NDNS"), dict(right_wall_friction=34.0), "right wall 34 deg"),
@@ -39,6 +39,8 @@ def add_arguments(p):
     p.add_argument("--ppc", type=int, default=2, help="particles per cell direction")
     p.add_argument("--discharge", type=float, default=8.0, help="discharge time [s] after the fill")
     p.add_argument("--fill-time", type=float, default=0.3, help="fill (settling) step [s]")
+    p.add_argument("--young", type=float, default=YOUNG,
+                   help="Young's modulus [Pa] (Table 5.3: 8 MPa; lower: larger stable increment)")
     p.add_argument("--variants", action="store_true", help="also the 34 deg right wall and rho_i = 1600 runs")
     p.add_argument("--cases", nargs="+", help="only these, e.g. concentric:NDNS eccentric:DS")
     p.add_argument("--surface-times", type=float, nargs="+", default=[0.5, 1.0, 2.5, 4.0, 6.0],
@@ -63,7 +65,7 @@ def _runs(a):
     rows = []
     for case, sand, kw, lab in todo:
         scene = dict(case=case, sand=sand, edge_cells=a.edge_cells, ppc=a.ppc, discharge_time=a.discharge,
-                     fill_time=a.fill_time, **kw)
+                     fill_time=a.fill_time, young=a.young, **kw)
         r = run_bin(a.bulkflow, a.runs, reuse=not a.no_reuse, **scene)
         r["label"] = f"{case} {sand}" + (f", {lab}" if lab else "")
         print(f"  {r['label']}: {r['particles']} particles, wall {r['wall']:.0f} s", flush=True)
@@ -113,7 +115,7 @@ def _velocities(r, frames, heights, avg_from):
 
 def run(a):
     print(f"flat-bottomed bins (thesis ch. 5): outlet {OUTLET * 1e3:g} mm, cell outlet/{2 * a.edge_cells + 1}, "
-          f"PPC {a.ppc}, fill {a.fill_time:g} s + discharge {a.discharge:g} s", flush=True)
+          f"PPC {a.ppc}, E {a.young / 1e6:g} MPa, fill {a.fill_time:g} s + discharge {a.discharge:g} s", flush=True)
     rows = _runs(a)
     bev = {C: beverloo_per_metre(RHO_I, C) for C in (0.64, 0.58)}
     table = []
