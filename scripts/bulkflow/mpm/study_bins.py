@@ -42,7 +42,8 @@ def add_arguments(p):
     p.add_argument("--young", type=float, default=YOUNG,
                    help="Young's modulus [Pa] (Table 5.3: 8 MPa; lower: larger stable increment)")
     p.add_argument("--variants", action="store_true", help="also the 34 deg right wall and rho_i = 1600 runs")
-    p.add_argument("--cases", nargs="+", help="only these, e.g. concentric:NDNS eccentric:DS")
+    p.add_argument("--cases", nargs="+",
+                   help="only these, e.g. concentric:NDNS eccentric:DS:4 (a third field: its own discharge time [s])")
     p.add_argument("--surface-times", type=float, nargs="+", default=[0.5, 1.0, 2.5, 4.0, 6.0],
                    help="s after opening")
     p.add_argument("--heights", type=float, nargs="+", default=[0.010, 0.040, 0.070], help="m above the outlet")
@@ -59,13 +60,19 @@ def _runs(a):
     from .bin_run import run_bin
     todo = [(c, s, {}, "") for c, s in CASES]
     if a.cases:
-        todo = [(c.split(":")[0], c.split(":")[1], {}, "") for c in a.cases]
+        todo = []
+        for item in a.cases:
+            f = item.split(":")
+            if len(f) not in (2, 3) or f[0] not in ("concentric", "eccentric") or f[1] not in ("NDNS", "DS"):
+                raise SystemExit(f"--cases {item}: expected concentric|eccentric:NDNS|DS[:discharge seconds]")
+            todo.append((f[0], f[1], dict(discharge_time=float(f[2])) if len(f) == 3 else {}, ""))
     if a.variants:
         todo += [(c, s, kw, lab) for (c, s), kw, lab in VARIANTS]
     rows = []
     for case, sand, kw, lab in todo:
         scene = dict(case=case, sand=sand, edge_cells=a.edge_cells, ppc=a.ppc, discharge_time=a.discharge,
-                     fill_time=a.fill_time, young=a.young, **kw)
+                     fill_time=a.fill_time, young=a.young)
+        scene.update(kw)
         r = run_bin(a.bulkflow, a.runs, reuse=not a.no_reuse, **scene)
         r["label"] = f"{case} {sand}" + (f", {lab}" if lab else "")
         print(f"  {r['label']}: {r['particles']} particles, wall {r['wall']:.0f} s", flush=True)
