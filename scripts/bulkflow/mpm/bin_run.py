@@ -8,21 +8,18 @@ study run again reads a finished run back instead of repeating it (`reuse=False`
     r = run_bin(exe, "out/mpm_study/runs", case="eccentric", sand="DS", edge_cells=1)
     r["mdr_bin"], r["t_ss"], r["wall"], r["base"]
 """
-import fcntl
-import hashlib
 import json
 import math
 import re
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
 from .bin_analysis import opening_time, steady_rate, steady_time
 from .bin_scene import bin_geometry, bin_scene
-from .hopper_run import DEFAULT_EXE, MPM_REVISION
+from .hopper_run import DEFAULT_EXE, cached_run
 
 
 def run_bin(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, label="", **scene):
@@ -32,17 +29,8 @@ def run_bin(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, label="",
     bin per metre of depth: twice a half model's), the 0.5 s window ends and rates, the geometry
     and the scene keywords."""
     text = bin_scene(**scene)
-    digest = hashlib.sha256(f"mpm revision {MPM_REVISION}\n{text}".encode()).hexdigest()[:12]
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    base = out / f"bin_{label + '_' if label else ''}{digest}"
-    meta = base.with_suffix(".json")
-    with open(base.with_suffix(".lock"), "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        if reuse and meta.exists():
-            r = json.loads(meta.read_text())
-            if r.get("digest") == digest:
-                return r
+
+    def make(base, meta, digest):
         base.with_suffix(".inp").write_text(text)
         t0 = time.perf_counter()
         res = subprocess.run([exe, str(base.with_suffix(".inp")), "--output", str(base), "--quiet"],
@@ -55,6 +43,8 @@ def run_bin(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, label="",
         r.update(digest=digest, wall=wall)
         meta.write_text(json.dumps(r, indent=1))
         return r
+
+    return cached_run(out_dir, f"bin_{label + '_' if label else ''}", text, reuse, make)
 
 
 def reduce_run(base, stdout, scene):

@@ -175,30 +175,14 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     w("** gravity: ramped in the fill step, then on at full value (amplitude in total time)")
     w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME")
     w(f"0., 0., {ramp:g}, 1.")
-    w("*STEP, NAME=FILL")
-    w("Outlet closed: the fill settles under gravity")
-    w("*DYNAMIC, EXPLICIT")
-    w(f", {fill_time:g}")
-    w("*DLOAD, AMPLITUDE=RAMP")
-    w(", GRAV, 9.81, 0., -1.")
-    w(f"*OUTPUT, FIELD, TIME INTERVAL={fill_time:g}")
-    w("*ELEMENT OUTPUT")
-    w("S, SDV")
-    w(f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}")
-    w("*ENERGY OUTPUT")
-    w("*END STEP")
-    w("*STEP, NAME=DISCHARGE")
-    w("Outlet open: the bin empties through the outlet")
-    w("*DYNAMIC, EXPLICIT")
-    w(f", {discharge_time:g}")
-    w("*MPM CONTROLS, DAMPING=0.")
-    w("*MPM WALL, NAME=OUTLET, OP=DELETE")
-    w(f"*OUTPUT, FIELD, TIME INTERVAL={field_dt:g}")
-    w("*ELEMENT OUTPUT")
-    w("S, SDV")
-    w(f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}")
-    w("*ENERGY OUTPUT")
-    w("*END STEP")
+    steps = (("FILL", "Outlet closed: the fill settles under gravity", fill_time,
+              ["*DLOAD, AMPLITUDE=RAMP", ", GRAV, 9.81, 0., -1."], fill_time),
+             ("DISCHARGE", "Outlet open: the bin empties through the outlet", discharge_time,
+              ["*MPM CONTROLS, DAMPING=0.", "*MPM WALL, NAME=OUTLET, OP=DELETE"], field_dt))
+    for name, text, period, loads, frame_dt in steps:
+        lines += [f"*STEP, NAME={name}", text, "*DYNAMIC, EXPLICIT", f", {period:g}", *loads,
+                  f"*OUTPUT, FIELD, TIME INTERVAL={frame_dt:g}", "*ELEMENT OUTPUT", "S, SDV",
+                  f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}", "*ENERGY OUTPUT", "*END STEP"]
     return "\n".join(lines) + "\n"
 
 
