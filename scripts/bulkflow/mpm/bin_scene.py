@@ -78,7 +78,11 @@ def bin_geometry(case="concentric", cell=None, outlet=OUTLET, width=WIDTH, fill=
     the grid treats its inner edge differently: docs/bins.md), half (True: half model)."""
     if case not in CASES:
         raise ValueError(f"case must be one of {CASES}")
+    if not (outlet > 0 and fill > 0 and width > 0) or (cell is not None and cell <= 0):
+        raise ValueError("outlet, width, fill and cell must be > 0")
     h = cell or bin_cell(outlet, edge_cells)
+    if width < outlet + 2 * h:
+        raise ValueError(f"the bin ({width:g} m) must be wider than the outlet ({outlet:g} m) by 2 cells")
     if case == "concentric":
         n = max(2, round(0.5 * width / h))
         return dict(cell=h, x_left=0.0, x_right=n * h, x_out0=0.0, x_out1=0.5 * outlet,
