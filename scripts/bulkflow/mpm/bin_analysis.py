@@ -14,7 +14,8 @@ two readers of a run's particle frames. The definitions (docs/bins.md, "Outputs"
 - free surface: the highest particle centre above the bottom (y >= 0) in columns of width dx; an
   empty column is nan (floor bare). Shape of a profile: its chord from the lowest to the highest
   end of the sloping part, and the mean signed distance of the profile above the chord over the
-  chord's rise; > +tol: convex (bulges up, like a heap), < -tol: concave (sags), else linear.
+  chord's rise; > +tol: convex (bulges up, like a heap), < -tol: concave (sags), else linear;
+  flat when the rise is below `min_rise` (the study: 2 cells).
 - two slopes (the eccentric bin): the two straight lines of least total squared error, split at
   the best breakpoint; their angles with the horizontal in degrees.
 - velocity profile at height H: the mass-weighted mean vertical velocity of the particles within
@@ -85,16 +86,17 @@ def surface_profile(x, y, x_lo, x_hi, dx):
     return 0.5 * (edges[1:] + edges[:-1]), top
 
 
-def surface_shape(xs, ys, tol=0.05):
+def surface_shape(xs, ys, tol=0.05, min_rise=0.0):
     """Shape of a one-sided profile: ('convex'|'linear'|'concave', bulge) where bulge is the mean
-    distance of the profile above the chord between its ends, over the chord's rise."""
+    distance of the profile above the chord between its ends, over the chord's rise; ('flat', nan)
+    when the rise is not above `min_rise` (the surface has hardly moved)."""
     ok = np.isfinite(ys)
     xs, ys = np.asarray(xs)[ok], np.asarray(ys)[ok]
     if len(xs) < 3:
         return "undefined", float("nan")
     rise = abs(ys[-1] - ys[0])
-    if rise <= 0:
-        return "undefined", float("nan")
+    if rise <= max(min_rise, 0.0):
+        return "flat", float("nan")
     chord = ys[0] + (ys[-1] - ys[0]) * (xs - xs[0]) / (xs[-1] - xs[0])
     bulge = float(np.mean(ys - chord) / rise)
     return ("convex" if bulge > tol else "concave" if bulge < -tol else "linear"), bulge

@@ -91,12 +91,12 @@ def _surfaces(r, frames, times):
         xs, ys = BA.surface_profile(near[1][:, 0], near[1][:, 1], geo["x_left"], geo["x_right"], h)
         item = dict(t=near[0], x=xs.tolist(), y=ys.tolist())
         if geo["half"]:
-            item["shape"], item["bulge"] = BA.surface_shape(xs, ys)
+            item["shape"], item["bulge"] = BA.surface_shape(xs, ys, min_rise=2 * h)
         else:
             # leave the column at each wall and the outlet's columns out of the line fits
             keep = (xs > geo["x_left"] + h) & (xs < geo["x_out0"])
             item.update(BA.two_slopes(xs[keep], ys[keep]))
-            item["shape"], item["bulge"] = BA.surface_shape(xs[keep][::-1], ys[keep][::-1])
+            item["shape"], item["bulge"] = BA.surface_shape(xs[keep][::-1], ys[keep][::-1], min_rise=2 * h)
         out.append(item)
     return out
 
@@ -122,7 +122,7 @@ def _velocities(r, frames, heights, avg_from):
 
 def run(a):
     print(f"flat-bottomed bins (thesis ch. 5): outlet {OUTLET * 1e3:g} mm, cell outlet/{2 * a.edge_cells + 1}, "
-          f"PPC {a.ppc}, E {a.young / 1e6:g} MPa, fill {a.fill_time:g} s + discharge {a.discharge:g} s", flush=True)
+          f"PPC {a.ppc}, E {a.young / 1e6:g} MPa, fill {a.fill_time:g} s + discharge {a.discharge:g} s (or the case's own)", flush=True)
     rows = _runs(a)
     bev = {C: beverloo_per_metre(RHO_I, C) for C in (0.64, 0.58)}
     table = []
