@@ -205,7 +205,8 @@ def _plot(out, rows, bev):
     for C, ls in ((0.64, "--"), (0.58, "-.")):
         ax[1].axhline(bev[C], c="k", ls=ls, lw=1, label=f"Beverloo C = {C:g}, k = 1.5 (rho_i 1800)")
     ax[0].set_ylabel("discharged mass [kg/m]")
-    ax[1].set_ylabel("MDR [kg/s/m] (thin: 0.1 s, thick: 0.5 s windows; dotted: T_ss)")
+    ax[1].set_ylabel("MDR [kg/s/m]")
+    ax[1].set_title("thin: 0.1 s windows, thick: 0.5 s (T_ss rule), dotted: T_ss", fontsize=9)
     for x in ax:
         x.set_xlabel("time after opening [s]")
         x.grid(alpha=0.3)
