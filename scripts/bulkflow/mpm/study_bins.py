@@ -14,8 +14,8 @@ Figures (bin_analysis.py has the definitions; docs/bins.md discusses them):
 - free surface profiles at `--surface-times` with their shape (convex/linear/concave) and, for
   the eccentric bin, its two slopes -> bins_surface.csv/.png;
 - time-averaged vertical velocity along y = 10, 40, 70 mm (`--heights`) from `--avg-from` s after
-  opening until T_ss or until the lowest point of the free surface comes within 2 cells of the
-  height -> bins_velocity.csv/.png.
+  opening until T_ss (the run's end if T_ss is less than 0.5 s after that start) or until the
+  lowest point of the free surface comes within 2 cells of the height -> bins_velocity.csv/.png.
 """
 import csv
 import json
@@ -104,7 +104,9 @@ def _surfaces(r, frames, times):
 def _velocities(r, frames, heights, avg_from):
     geo = r["geometry"]
     h = geo["cell"]
-    t_end = r["t_ss"] if r["t_ss"] is not None else frames[-1][0]
+    # a T_ss less than 0.5 s after the averaging start leaves too few frames: then the run's end
+    t_ss = r["t_ss"]
+    t_end = t_ss if t_ss is not None and t_ss >= avg_from + 0.5 else frames[-1][0]
     profiles = []
     for H in heights:
         used = []
