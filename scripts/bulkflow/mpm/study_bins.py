@@ -231,6 +231,7 @@ def _plot(out, rows, bev):
             ax[0, k].plot(1e3 * x, 1e3 * y, label=f"{s['t']:.1f} s: {s['shape']}")
         ax[0, k].set_title(r["label"], fontsize=9)
         ax[0, k].set_xlabel("x [mm]" + (" (outlet centre 0)" if geo["half"] else ""))
+        ax[0, k].set_ylim(0.0, 1e3 * (geo["fill"] + 0.01))
         ax[0, k].set_aspect("equal")
         ax[0, k].legend(fontsize=6)
     ax[0, 0].set_ylabel("free surface height [mm]")
