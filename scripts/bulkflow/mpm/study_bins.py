@@ -117,7 +117,9 @@ def _velocities(r, frames, heights, avg_from):
             if np.nanmin(top) < H + 2 * h:
                 break
             used.append((x, v, m))
-        xs, vy = BA.velocity_profile(used, H, h, geo["x_left"], geo["x_right"], 0.5 * h)
+        # columns one particle spacing wide: every column of the lattice holds a particle
+        dx = h / r["scene"].get("ppc", 2)
+        xs, vy = BA.velocity_profile(used, H, h, geo["x_left"], geo["x_right"], dx)
         profiles.append(dict(height=H, frames=len(used), x=xs.tolist(), v=vy.tolist()))
     return profiles
 
