@@ -45,10 +45,18 @@ def run_hopper(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, ranks=
     base (output base path), wall [s], psteps, particles, mdr (half model) and mdr_full [kg/s/m],
     mfi, v_out, rho_out (outlet path means of the last 3 frames) and the scene keywords."""
     text = scene_text(**scene)
+    return cached_run(out_dir, f"hopper_{label + '_' if label else ''}", text, reuse,
+                      lambda base, meta, digest: _run_and_reduce(exe, base, meta, text, digest, ranks, scene))
+
+
+def cached_run(out_dir, prefix, text, reuse, make):
+    """The run of scene `text` named `prefix` + the hash of the text and MPM_REVISION in `out_dir`:
+    its recorded result (`<base>.json`) if it has the same hash and `reuse`, else make(base, meta,
+    digest), which runs it and writes meta."""
     digest = hashlib.sha256(f"mpm revision {MPM_REVISION}\n{text}".encode()).hexdigest()[:12]
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    base = out / f"hopper_{label + '_' if label else ''}{digest}"
+    base = out / f"{prefix}{digest}"
     meta = base.with_suffix(".json")
     # two studies asking for the same case at once: the second waits and reads the first's result
     with open(base.with_suffix(".lock"), "w") as lock:
@@ -57,7 +65,7 @@ def run_hopper(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, ranks=
             r = json.loads(meta.read_text())
             if r.get("digest") == digest:
                 return r
-        return _run_and_reduce(exe, base, meta, text, digest, ranks, scene)
+        return make(base, meta, digest)
 
 
 def _run_and_reduce(exe, base, meta, text, digest, ranks, scene):
