@@ -15,11 +15,12 @@
      its own CPU seconds), which the other jobs on the machine disturb far less;
    and each rank's peak memory (max RSS). On 2 ranks (particle decomposition, replicated grid)
    the CPU time includes what a rank spins in MPI while it waits for the other at the grid sums.
-2. --compare OLD_BINARY: every case above with OLD and NEW alternated (old, new, new, old, ... for
-   --rounds rounds), in this one run, so both see the same machine; prints the medians and the
-   ratios new/old (higher is faster), the memory of both, and whether the history CSVs are
-   byte-identical (else the largest relative difference of a history value, scaled by the
-   column's largest magnitude).
+2. --compare OLD_BINARY: every case above with OLD, NEW (the same deck: SORT=0, the old sums bit
+   for bit) and NEW with *MPM CONTROLS, SORT=N (--sort, cell order) alternated (forward, then
+   backward, for --rounds rounds), in this one run, so all see the same machine; prints the
+   medians and the ratios to OLD (higher is faster), the memory per rank, and whether the
+   history CSV is byte-identical to OLD's (else the largest difference of a history value
+   relative to its column's largest magnitude).
 3. --discharge S: the wall time of the whole ch. 4 hopper run (1 s fill + S s discharge with
    inflow) at cell --cell (default 0.125/4.5 = 0.0278 m: the outlet half-width 4.5 cells with its
    edge mid-cell, within 0.6 % of 5.5 cells in the outlet centre velocity and 2.3 % in the MDR;
@@ -195,30 +196,40 @@ def plain(tmp, a):
     print(f"  (particle-steps/s; load average at the end {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
 
 
+def with_sort(scene, every, tmp):
+    """The scene with SORT=every on its *MPM CONTROLS lines (a copy; the old binary does not
+    know the option)."""
+    text = re.sub(r"^(\*MPM CONTROLS[^\n]*)$", lambda m: f"{m.group(1)}, SORT={every}", scene.read_text(), flags=re.M)
+    out = tmp / f"{scene.stem}_sort{every}.inp"
+    out.write_text(text)
+    return out
+
+
 def compare(tmp, a):
-    print(f"  OLD {a.compare}\n  NEW {a.bulkflow}\n  {a.rounds} rounds, alternated (old, new, new, old, ...)")
-    print("  case                 per core cpu: old      new     new/old | wall: old      new     new/old |"
-          " max RSS/rank old, new | history")
+    variants = [("old", a.compare, 0), ("new", a.bulkflow, 0)] + ([("sorted", a.bulkflow, a.sort)] if a.sort else [])
+    print(f"  old    {a.compare}\n  new    {a.bulkflow} (SORT=0: block order, bit for bit the old sums)")
+    if a.sort:
+        print(f"  sorted {a.bulkflow} with *MPM CONTROLS, SORT={a.sort} (cell order, particle-major transfers)")
+    print(f"  {a.rounds} rounds, the variants alternated (forward, then backward)")
+    print("  case                 variant  per core: cpu  x old | wall      x old | max RSS/rank | history vs old")
     for label, sc, incr, ranks in cases(tmp, a):
-        got = {"old": [], "new": []}
+        got = {tag: [] for tag, _, _ in variants}
         for k in range(a.rounds):
-            order = ("old", "new") if k % 2 == 0 else ("new", "old")
-            for tag in order:
-                binary = a.compare if tag == "old" else a.bulkflow
-                res = measured_run(binary, sc, tmp / f"{sc.stem}_np{ranks}_{tag}", incr, ranks)
-                got[tag].append(res)
+            for tag, binary, every in (variants if k % 2 == 0 else variants[::-1]):
+                scene = with_sort(sc, every, tmp) if every else sc
+                got[tag].append(measured_run(binary, scene, tmp / f"{sc.stem}_np{ranks}_{tag}", incr, ranks))
         med = {}
-        for tag in ("old", "new"):
-            cpu = statistics.median(describe(r, ranks)[0] for r in got[tag])
-            wall = statistics.median(describe(r, ranks)[1] for r in got[tag])
-            rss = max(max(r["rss"]) for r in got[tag])
-            med[tag] = (cpu, wall, rss)
-        hist = history_difference(tmp / f"{sc.stem}_np{ranks}_old_history.csv",
-                                  tmp / f"{sc.stem}_np{ranks}_new_history.csv")
-        o, n = med["old"], med["new"]
-        print(f"  {label:20s} {o[0]:.3e} {n[0]:.3e}  {n[0] / o[0]:5.2f}  | {o[1]:.3e} {n[1]:.3e}  {n[1] / o[1]:5.2f}  |"
-              f" {o[2]:6.0f} {n[2]:6.0f} MB        | {hist}")
-    print(f"  (particle-steps/s per core, medians of {a.rounds}; {a.increments} increments 2D, {a.increments_3d} 3D;"
+        for tag, _, _ in variants:
+            med[tag] = (statistics.median(describe(r, ranks)[0] for r in got[tag]),
+                        statistics.median(describe(r, ranks)[1] for r in got[tag]),
+                        max(max(r["rss"]) for r in got[tag]))
+        for tag, _, _ in variants:
+            o, n = med["old"], med[tag]
+            hist = "" if tag == "old" else history_difference(tmp / f"{sc.stem}_np{ranks}_old_history.csv",
+                                                              tmp / f"{sc.stem}_np{ranks}_{tag}_history.csv")
+            print(f"  {label:20s} {tag:7s}  {n[0]:.3e} {n[0] / o[0]:5.2f} | {n[1]:.3e} {n[1] / o[1]:5.2f} |"
+                  f" {n[2]:8.0f} MB  | {hist}")
+    print(f"  (particle-steps/s per core, medians of {a.rounds} runs; {a.increments} increments 2D, {a.increments_3d} 3D;"
           f" load average at the end {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
 
 
@@ -262,6 +273,8 @@ def main():
     p.add_argument("--increments-3d", type=int, default=300, help="3D increments (default 300)")
     p.add_argument("--compare", metavar="OLD_BINARY", help="alternate OLD_BINARY and --bulkflow, print ratios")
     p.add_argument("--rounds", type=int, default=3, help="--compare: runs of each binary per case (default 3)")
+    p.add_argument("--sort", type=int, default=20, metavar="N",
+                   help="--compare: also run the new binary with *MPM CONTROLS, SORT=N (default 20; 0: not)")
     p.add_argument("--discharge", type=float, default=0.0)
     # the converged resolution of study a (src/mpm/README.md): outlet half-width 4.5 cells, edge mid-cell
     p.add_argument("--cell", type=float, default=0.125 / 4.5)
