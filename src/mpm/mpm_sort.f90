@@ -47,7 +47,7 @@ contains
        nl = 0
        do jb = ib, nblocks
           if (done(jb)) cycle
-          if (blocks(jb)%material /= blocks(ib)%material .or. blocks(jb)%half /= blocks(ib)%half) cycle
+          if (blocks(jb)%material /= blocks(ib)%material .or. abs(blocks(jb)%half - blocks(ib)%half) > 0) cycle
           nl = nl + 1
           list(nl) = jb
           done(jb) = .true.
