@@ -1,7 +1,7 @@
 !> The material-point keywords of a scene (bulkflow's own; docs/keywords.md, section "MPM"):
 !>
 !>   *MPM GRID, CELL=h [, SHAPE=GIMP|LINEAR]        data: lo corner; hi corner (2 or 3 values)
-!>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a]   model data or in a step; carries over
+!>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a] [, SORT=n]   model data or in a step; carries over
 !>   *PARTICLES, MATERIAL=name [, PPC=n] [, TYPE=BOX|POLYGON] [, Z1=, Z2=] [, VX=, VY=, VZ=]
 !>                                                  data: BOX lo; hi  |  POLYGON x, y per line
 !>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, OP=DELETE]
@@ -294,17 +294,20 @@ contains
     type(mpm_step_t), intent(inout) :: c
     type(error_t), intent(inout) :: err
     real(dp) :: flip, cfl, damping
+    integer :: sort
 
-    call blk%check_params([character(len=8) :: 'FLIP', 'CFL', 'DAMPING'], err)
+    call blk%check_params([character(len=8) :: 'FLIP', 'CFL', 'DAMPING', 'SORT'], err)
     if (.not. err%raised) call blk%get_real('FLIP', flip, err, default=c%flip, minimum=0.0_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('CFL', cfl, err, default=c%cfl, minimum=1.0e-3_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('DAMPING', damping, err, default=c%damping, minimum=0.0_dp, &
          maximum=0.99_dp)
+    if (.not. err%raised) call blk%get_integer('SORT', sort, err, default=c%sort, minimum=0)
     if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
     if (err%raised) return
     c%flip = flip
     c%cfl = cfl
     c%damping = damping
+    c%sort = sort
   end subroutine read_controls
 
   subroutine material_param(blk, model, k, err)

@@ -65,6 +65,9 @@ module mpm_scene
      real(dp) :: flip = 0.99_dp             !< PIC/FLIP blend α (1: FLIP, 0: PIC)
      real(dp) :: cfl = 0.3_dp               !< Δt = cfl h / max(c + |v|)
      real(dp) :: damping = 0                !< local non-viscous damping coefficient on the grid
+     !> particles sorted by cell every `sort` increments, P2G and remap particle by particle
+     !> (src/mpm/mpm_sort.f90); 0: block order and node-major sums (the results of before, bit for bit)
+     integer :: sort = 0
      type(mpm_inflow_t) :: inflow
   end type mpm_step_t
 

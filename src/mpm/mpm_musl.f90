@@ -15,7 +15,8 @@ module mpm_musl
   use mpm_grid, only: grid_sum_length, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t
   use mpm_shape, only: block_stencil
-  use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum
+  use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles
+  use mpm_sort, only: sort_due, sort_blocks
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
   use mpm_setup, only: mark_wall_nodes
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
@@ -96,9 +97,19 @@ contains
     s = st%step
     call fx%start(fx_p2g)
     call grid_reset_sums(st%g)
+    ! *MPM CONTROLS, SORT=n: particles in cell order, transfers particle by particle (mpm_sort)
+    if (sort_due(m%mpm%steps(s)%sort, st%increment)) &
+         call sort_blocks(st%blocks, st%nblocks, st%nd, st%g%lo, st%g%h, st%g%n)
     do ib = 1, st%nblocks
        call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
-       call p2g(st, st%blocks(ib))
+       if (m%mpm%steps(s)%sort > 0) then
+          associate (b => st%blocks(ib))
+            call scatter_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                 b%w1, b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%g%mass, st%g%mom, st%g%force)
+          end associate
+       else
+          call p2g(st, st%blocks(ib))
+       end if
     end do
     if (st%nranks > 1) call reduce_grid(st, .true.)
     st%g%mass_own = st%g%mass
@@ -145,7 +156,15 @@ contains
     call fx%start(fx_g2p)
     call grid_clear(st%nd * st%g%nn, st%g%mom)
     do ib = 1, st%nblocks
-       call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
+       if (m%mpm%steps(s)%sort > 0) then
+          associate (b => st%blocks(ib))
+            call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+                 st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%g%mom, &
+                 st%w_external)
+          end associate
+       else
+          call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
+       end if
     end do
     if (st%nranks > 1) call reduce_grid(st, .false.)
     do k = 1, size(m%mpm%walls)
