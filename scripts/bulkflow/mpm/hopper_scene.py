@@ -48,6 +48,47 @@ def eps_cv_from_eta(eta_cv, eta_i=ETA_INITIAL):
     return math.log(eta_i / eta_cv)
 
 
+def material_lines(name, model="MC", density=1600.0, young=1.0e7, poisson=0.2, phi=20.0, psi_initial=15.0,
+                   eps_cv=0.2, psi_constant=None, dilation=True):
+    """The *MATERIAL block of the hopper fill (Table 4.2/4.3 by default; module doc): Mohr-Coulomb with
+    the dilation table (VUSDFLD), a constant dilation angle, the built-in *MOHR COULOMB (no dilation) or
+    the matched Drucker-Prager. Shared by the wedge (this module) and the cone (cone_scene.py)."""
+    lines = []
+    w = lines.append
+    w(f"*MATERIAL, NAME={name}")
+    w("*DENSITY")
+    w(f"{_num(density)}")
+    if model == "DP":
+        # linear Drucker-Prager from the Mohr-Coulomb parameters by the plane-strain match
+        w("*USER MATERIAL, CONSTANTS=6")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant or 0.0)}, 0., 1.")
+        w("*DEPVAR")
+        w("8")
+    elif psi_constant is not None:
+        w("*USER MATERIAL, CONSTANTS=16")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant)}, 0., 0., 0., 0.")
+        w("0., 0., 0., 0., 0., 1., 0., 0.")
+        w("*DEPVAR")
+        w("8")
+    elif dilation:
+        # props layout: umat/README.md (as inputs/demo/wedge_hopper_dilation.inp)
+        w("*USER MATERIAL, CONSTANTS=22")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, 0., 0., 0., 0., 0.")
+        w("0., 0., 0., 0., 2., 1., 0., 0.")
+        w(f"{_num(phi)}, {_num(psi_initial)}, 0., {_num(phi)}, 0., {_num(eps_cv)}")
+        w("*DEPVAR")
+        w("8")
+        w("*USER DEFINED FIELD")
+    else:
+        w("*ELASTIC")
+        w(f"{_num(young)}, {_num(poisson)}")
+        w("*MOHR COULOMB")
+        w(f"{_num(phi)}, 0.")
+        w("*MOHR COULOMB HARDENING")
+        w("0., 0.")
+    return lines
+
+
 def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_friction=5.0,
                  fill_time=1.0, ramp=0.6, discharge_time=3.0, inflow=True, fill_damping=0.1,
                  flip=0.99, cfl=0.3, shape="GIMP", field_frames=10, history_dt=0.01,
@@ -81,37 +122,9 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w(f"{hi[0]:.9f}, {hi[1]:.9f}")
     w(f"*MPM CONTROLS, FLIP={flip:g}, CFL={cfl:g}, DAMPING={fill_damping:g}")
     name = "DP-FILL" if model == "DP" else "MC-FILL"
-    w(f"*MATERIAL, NAME={name}")
-    w("*DENSITY")
-    w(f"{_num(density)}")
-    if model == "DP":
-        # linear Drucker-Prager from the Mohr-Coulomb parameters by the plane-strain match
-        w("*USER MATERIAL, CONSTANTS=6")
-        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant or 0.0)}, 0., 1.")
-        w("*DEPVAR")
-        w("8")
-    elif psi_constant is not None:
-        w("*USER MATERIAL, CONSTANTS=16")
-        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant)}, 0., 0., 0., 0.")
-        w("0., 0., 0., 0., 0., 1., 0., 0.")
-        w("*DEPVAR")
-        w("8")
-    elif dilation:
-        # props layout: umat/README.md (as inputs/demo/wedge_hopper_dilation.inp)
-        w("*USER MATERIAL, CONSTANTS=22")
-        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, 0., 0., 0., 0., 0.")
-        w("0., 0., 0., 0., 2., 1., 0., 0.")
-        w(f"{_num(phi)}, {_num(psi_initial)}, 0., {_num(phi)}, 0., {_num(eps_cv)}")
-        w("*DEPVAR")
-        w("8")
-        w("*USER DEFINED FIELD")
-    else:
-        w("*ELASTIC")
-        w(f"{_num(young)}, {_num(poisson)}")
-        w("*MOHR COULOMB")
-        w(f"{_num(phi)}, 0.")
-        w("*MOHR COULOMB HARDENING")
-        w("0., 0.")
+    lines += material_lines(name, model=model, density=density, young=young, poisson=poisson, phi=phi,
+                            psi_initial=psi_initial, eps_cv=eps_cv, psi_constant=psi_constant,
+                            dilation=dilation)
     w(f"*PARTICLES, MATERIAL={name}, PPC={ppc}, TYPE=POLYGON")
     for x, y in [(0.0, y0), (0.5 * outlet, y0), (xtop, ytop), (0.0, ytop)]:
         w(f"{x:.9f}, {y:.9f}")

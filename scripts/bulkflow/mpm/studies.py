@@ -41,6 +41,7 @@ MODULE_STUDIES = {
     "flow-mode": "study_flow_mode",
     "mc-dp": "study_mc_dp",
     "parametric": "study_parametric",
+    "conical": "study_conical",
 }
 
 
