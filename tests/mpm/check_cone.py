@@ -14,8 +14,8 @@ kinds:
           x = 0 and z = 0, both mirrored) filled and discharged: exact mass balance and particle
           counts, no outflow while the outlet is closed, the fill's weight carried by the cone and
           the outlet plate at the end of the fill (vertical wall forces within 3 % of M g),
-          the quarter model symmetric under x <-> z (centre of mass XCM1 = XCM3 within 1e-3 of the
-          radius), no particle behind a symmetry plane or outside the hopper, and discharge
+          the two symmetry planes' reactions equal and normal to them (1e-6), the quarter model
+          symmetric under x <-> z (centre of mass XCM1 = XCM3 within 1e-3 of the radius), no particle behind a symmetry plane or outside the hopper, and discharge
           (MASS_OUT > 0, MDR integrates to MASS_OUT)
 Figures are printed so the test log holds them.
 """
@@ -101,6 +101,10 @@ def hopper(args):
     check(abs(-carried / weight - 1) < 0.03, f"end of fill: cone {-hist['WALLF2_CONE'][i]:.2f} N + outlet "
           f"{-hist['WALLF2_OUTLET'][i]:.2f} N = {-carried:.2f} N vs weight {weight:.2f} N "
           f"(cone carries {share:.1%}); ALLKE {hist['ALLKE'][i]:.2e} J")
+    fx, fz = hist["WALLF1_SYMX"][i], hist["WALLF3_SYMZ"][i]
+    check(abs(fx - fz) <= 1e-6 * abs(fx) and abs(hist["WALLF2_SYMZ"][i]) <= 1e-6 * abs(fz),
+          f"end of fill: the two symmetry planes' reactions are equal, {fx:.4f} N and {fz:.4f} N, and normal "
+          f"to them (SYMZ's vertical part {hist['WALLF2_SYMZ'][i]:.2e} N)")
     asym = np.abs(hist["XCM1"] - hist["XCM3"])[hist["particles"] > 0].max() / radius
     check(asym < 1e-3, f"x <-> z symmetry of the quarter model: max |XCM1 - XCM3| / R = {asym:.2e}")
     t = math.tan(math.radians(theta))

@@ -112,9 +112,9 @@ def cone_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.2, radius=0.4, height=0.8,
         w(f"*PARTICLES, MATERIAL={name}, PPC={ppc}, TYPE=POLYGON, Z1={zc - 0.5 * dz:.9f}, Z2={zc + 0.5 * dz:.9f}")
         for x, y in poly:
             w(f"{x:.9f}, {y:.9f}")
-    w("*MPM WALL, NAME=SYM-X, TYPE=SYMMETRY")
+    w("*MPM WALL, NAME=SYMX, TYPE=SYMMETRY")
     w("0., 0., 0., 1., 0., 0.")
-    w("*MPM WALL, NAME=SYM-Z, TYPE=SYMMETRY")
+    w("*MPM WALL, NAME=SYMZ, TYPE=SYMMETRY")
     w("0., 0., 0., 0., 0., 1.")
     w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu:.9f}")
     w(f"0., {y0:.9f}, 0., 0., 1., 0.")
