@@ -25,7 +25,7 @@ import argparse
 import math
 import sys
 
-from .hopper_scene import _num, material_lines
+from .hopper_scene import material_lines, step_lines
 
 
 def cone_geometry(theta, outlet, radius):
@@ -133,51 +133,29 @@ def cone_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.2, radius=0.4, height=0.8,
     w(f"{mu:.9f}")
     w("*CONTACT PAIR, INTERACTION=WALL-FRICTION")
     w(", CONE")
-    w("** gravity: ramped in the fill step, then on at full value (amplitude in total time)")
-    w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME")
-    w(f"0., 0., {ramp:g}, 1.")
-    w("*STEP, NAME=FILL")
-    w("Outlet closed: the fill settles under gravity")
-    w("*DYNAMIC, EXPLICIT")
-    w(f", {fill_time:g}")
-    w("*DLOAD, AMPLITUDE=RAMP")
-    w(", GRAV, 9.81, 0., -1., 0.")
-    _outputs(w, field_frames, history_dt)
-    w("*END STEP")
-    if discharge:
-        w("*STEP, NAME=DISCHARGE")
-        w("Outlet open: discharge" + (" with inflow at the top" if inflow else ""))
-        w("*DYNAMIC, EXPLICIT")
-        w(f", {discharge_time:g}")
-        w("*MPM CONTROLS, DAMPING=0.")
-        w("*MPM WALL, NAME=OUTLET, OP=DELETE")
-        if inflow:
-            w(f"*INFLOW, MATERIAL={name}, LEVEL={ytop:.9f}, PPC={ppc}")
-            w(f"0., 0., {radius:.9f}, {radius:.9f}")
-        _outputs(w, field_frames, history_dt)
-        w("*END STEP")
+    inflow_lines = [f"*INFLOW, MATERIAL={name}, LEVEL={ytop:.9f}, PPC={ppc}",
+                    f"0., 0., {radius:.9f}, {radius:.9f}"] if inflow else []
+    lines += step_lines(ramp, fill_time, discharge_time, field_frames, history_dt, ", GRAV, 9.81, 0., -1., 0.",
+                        inflow_lines, discharge)
     return "\n".join(lines) + "\n"
 
 
-def _outputs(w, field_frames, history_dt):
-    w(f"*OUTPUT, FIELD, NUMBER INTERVAL={field_frames}")
-    w("*ELEMENT OUTPUT")
-    w("S, SDV")
-    w(f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}")
-    w("*ENERGY OUTPUT")
+def add_size_arguments(p):
+    """Options the generator and the conical study share: cell, hopper size, internal friction."""
+    p.add_argument("--cell", type=float, default=0.05, help="grid cell [m]")
+    p.add_argument("--outlet", type=float, default=0.2, help="outlet diameter D [m]")
+    p.add_argument("--radius", type=float, default=0.4, help="bin (cylinder) radius R [m]")
+    p.add_argument("--height", type=float, default=0.8, help="fill height above the outlet H [m]")
+    p.add_argument("--phi", type=float, default=30.0, help="internal friction angle (Jenike's delta) [deg]")
 
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("-o", "--output", required=True)
-    p.add_argument("--cell", type=float, default=0.05)
+    add_size_arguments(p)
     p.add_argument("--ppc", type=int, default=2)
     p.add_argument("--theta", type=float, default=30.0, help="cone half angle from the vertical [deg]")
-    p.add_argument("--outlet", type=float, default=0.2, help="outlet diameter D [m]")
-    p.add_argument("--radius", type=float, default=0.4, help="bin (cylinder) radius R [m]")
-    p.add_argument("--height", type=float, default=0.8, help="fill height above the outlet [m]")
     p.add_argument("--wall-friction", type=float, default=20.0, help="wall friction angle phi_w [deg]")
-    p.add_argument("--phi", type=float, default=30.0, help="internal friction angle [deg]")
     p.add_argument("--psi-initial", type=float, default=15.0, help="dilation angle at eps_v = 0 [deg]")
     p.add_argument("--eps-cv", type=float, default=0.2, help="volumetric strain where psi reaches 0")
     p.add_argument("--psi-constant", type=float, help="constant dilation angle instead of the table [deg]")

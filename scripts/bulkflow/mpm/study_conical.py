@@ -29,7 +29,7 @@ import numpy as np
 
 from ..theory.beverloo import C_DEFAULT, beverloo_circular, rose_tanaka_factor
 from ..theory.flow_mode import MFI_THRESHOLD, classify_mfi, conical_mass_flow_limit
-from .cone_scene import cone_geometry, cone_scene
+from .cone_scene import add_size_arguments, cone_geometry, cone_scene
 from .discharge import mean_discharge_rate
 from .hopper_run import DEFAULT_EXE, cached_run
 from .study_flow_mode import mfi_crossings
@@ -38,14 +38,10 @@ GRAVITY = 9.81
 
 
 def add_arguments(p):
-    p.add_argument("--cell", type=float, default=0.05, help="grid cell [m]")
+    add_size_arguments(p)
     p.add_argument("--thetas", type=float, nargs="+", default=[15.0, 30.0, 45.0],
                    help="cone half angles from the vertical [deg]")
     p.add_argument("--phi-ws", type=float, nargs="+", default=[10.0, 20.0], help="wall friction angles [deg]")
-    p.add_argument("--phi", type=float, default=30.0, help="internal friction angle (Jenike's delta) [deg]")
-    p.add_argument("--outlet", type=float, default=0.2, help="outlet diameter D [m]")
-    p.add_argument("--radius", type=float, default=0.4, help="bin radius R [m]")
-    p.add_argument("--height", type=float, default=0.8, help="fill height above the outlet H [m]")
     p.add_argument("--fill", type=float, default=0.6, help="fill time [s] (gravity ramp 0.3 s)")
     p.add_argument("--discharge", type=float, default=1.0, help="discharge time [s]")
     p.add_argument("--skip", type=float, default=0.3, help="MDR from this time after opening [s]")
