@@ -47,6 +47,8 @@ def add_arguments(p):
     p.add_argument("--skip", type=float, default=0.3, help="MDR from this time after opening [s]")
     p.add_argument("--frames", type=int, default=3, help="last particle frames pooled for the MFI")
     p.add_argument("--field-frames", type=int, default=10, help="particle frames per step")
+    p.add_argument("--leave-out", dest="skip_cases", nargs="+", default=[], metavar="THETA:PHI_W",
+                   help="pairs of the sweep not run (a time budget); reported as left out")
 
 
 def scene_keywords(a, theta, phi_w):
@@ -98,8 +100,12 @@ def run(a):
     print(f"conical hopper (quarter model), D {a.outlet:g} m, R {a.radius:g} m, H {a.height:g} m, phi {a.phi:g} deg, "
           f"cell {a.cell:g} m; {a.fill:g} s fill + {a.discharge:g} s discharge", flush=True)
     rows = []
+    skipped = {tuple(float(v) for v in c.split(":")) for c in a.skip_cases}
     for phi_w in a.phi_ws:
         for theta in a.thetas:
+            if (theta, phi_w) in skipped:
+                print(f"  theta {theta:4.1f} phi_w {phi_w:4.1f}: left out (--leave-out)", flush=True)
+                continue
             r = run_cone(exe, a.runs, not a.no_reuse, a, theta, phi_w)
             rt = beverloo * rose_tanaka_factor(theta)
             row = dict(theta=theta, phi_w=phi_w, mfi=r["mfi"], mode=classify_mfi(r["mfi"]), n_wall=r["n_wall"],
@@ -124,6 +130,8 @@ def run(a):
     for phi_w in a.phi_ws:
         g = sorted((r for r in rows if r["phi_w"] == phi_w), key=lambda r: r["theta"])
         tc = conical_mass_flow_limit(a.phi, phi_w)
+        if not g:
+            continue
         cross = mfi_crossings([r["theta"] for r in g], [r["mfi"] for r in g])
         if cross:
             for c in cross:
@@ -145,7 +153,7 @@ def run(a):
         w.writeheader()
         w.writerows(rows)
     with open(f"{out}/conical.json", "w") as f:
-        json.dump(dict(cell=a.cell, outlet=a.outlet, radius=a.radius, height=a.height, phi=a.phi, fill=a.fill,
+        json.dump(dict(skipped=sorted(skipped), cell=a.cell, outlet=a.outlet, radius=a.radius, height=a.height, phi=a.phi, fill=a.fill,
                        discharge=a.discharge, skip=a.skip, frames=a.frames, threshold=MFI_THRESHOLD,
                        beverloo=dict(C=C_DEFAULT, rho=density, kd=0.0, mdr=beverloo), rows=rows,
                        transitions=transitions), f, indent=1)
