@@ -10,10 +10,12 @@ without inflow, and reduces each run to:
   form C rho sqrt(g) (D - k d)^(5/2) and Rose-Tanaka's factor (tan theta tan phi_d)^(-0.35)
   (theory/beverloo.py; C = 0.58, d = 0: the continuum has no grain size, rho = the fill's density);
 * MFI in 3D (the 2D definition of discharge.py with the wall line replaced by the cone): mean
-  vertical velocity of the particles within one cell of the hopper wall (distance normal to the
-  cone, or to the cylinder above it) over the mean vertical velocity of the particles within one
-  cell of the axis (r < h), both in the band y0 + 2D .. y0 + 0.75 H, pooled over the last
-  `--frames` particle frames; mass flow if MFI > 0.3 (theory/flow_mode.py);
+  vertical velocity of the particles within one cell of the cone (distance normal to it) over the
+  mean vertical velocity of the particles within one cell of the axis (r < h), both in the band
+  y0 + D .. min(y0 + 0.75 H, y_t) -- the conical section, whose wall Jenike's criterion is about
+  (the 2D band y0 + 2b .. y0 + 0.75 H lies in the cylinder for wide cones: at theta = 45 deg it
+  gave 0.875, the bin's plug flow) -- pooled over the last `--frames` particle frames; mass flow if
+  MFI > 0.3 (theory/flow_mode.py). Computed from the run's frames at every call (not cached);
 * where the MFI crosses 0.3 along theta for each phi_w (linear interpolation between the
   bracketing runs, study_flow_mode.mfi_crossings), against Jenike's conical mass-flow limit
   theta_c(delta = phi, phi_w) (theory/flow_mode.conical_mass_flow_limit), in degrees.
@@ -69,9 +71,8 @@ def cone_mfi(h5path, theta, outlet, radius, height, frames=3):
             x, v = g["coordinates"][:], g["V"][:]
             r = np.hypot(x[:, 0], x[:, 2])
             y = x[:, 1]
-            # distance to the wall: normal to the cone below y_t, to the cylinder above
-            d_wall = np.where(y < y_t, (y * math.tan(t) - r) * math.cos(t), radius - r)
-            band = (y > y0 + 2 * outlet) & (y < y0 + 0.75 * height)
+            d_wall = (y * math.tan(t) - r) * math.cos(t)          # normal to the cone
+            band = (y > y0 + outlet) & (y < min(y0 + 0.75 * height, y_t))
             vw.append(v[band & (d_wall < h), 1])
             va.append(v[band & (r < h), 1])
     vw, va = np.concatenate(vw), np.concatenate(va)
@@ -86,11 +87,11 @@ def run_cone(exe, runs, reuse, a, theta, phi_w):
     def reduce(base, run):
         hist = np.genfromtxt(str(base) + "_history.csv", delimiter=",", names=True)
         mdr = 4 * float(mean_discharge_rate(hist, a.skip))
-        mfi, n_wall, n_axis = cone_mfi(str(base) + ".h5", theta, a.outlet, a.radius, a.height, a.frames)
-        return dict(run, mdr_full=mdr, mfi=mfi, n_wall=n_wall, n_axis=n_axis,
-                    mass0=4 * float(hist["MASS"][0]), scene=kw)
+        return dict(run, mdr_full=mdr, mass0=4 * float(hist["MASS"][0]), scene=kw)
 
-    return cached_run(exe, runs, cone_scene(**kw), "cone_", reduce, reuse)
+    r = cached_run(exe, runs, cone_scene(**kw), "cone_", reduce, reuse)
+    r["mfi"], r["n_wall"], r["n_axis"] = cone_mfi(r["base"] + ".h5", theta, a.outlet, a.radius, a.height, a.frames)
+    return r
 
 
 def run(a):
