@@ -29,21 +29,14 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from check_mpm import check, check_report, mass_balance, run  # noqa: E402
+from check_mpm import check, check_report, mass_balance, run, slide_acceleration  # noqa: E402
 
 
 def slide(args):
     base, out, hist = run(args.bulkflow, args.scene, args.workdir)
     check_report(out, ["walls", "gravity"], ["damping", "outflow", "inflow"])
-    a, mu, grav = math.radians(30.0), 0.2, 9.81
-    t = hist["time"]
-    vs = hist["VCM1"] * math.cos(a) - hist["VCM2"] * math.sin(a)
-    m = t >= 0.1
-    acc = np.polyfit(t[m], vs[m], 1)[0]
-    expected = grav * (math.sin(a) - mu * math.cos(a))
-    err = acc / expected - 1
-    check(abs(err) < 0.02, f"cone generator: a = {acc:.5f} m/s2, g(sin a - mu cos a) = {expected:.5f}, "
-          f"error {err:+.2e}")
+    a, grav = math.radians(30.0), 9.81
+    acc, vs, m = slide_acceleration(hist, "cone generator")
     mass = hist["MASS"][0]
     force = np.array([hist[f"WALLF{i}_CONE"][m].mean() for i in (1, 2, 3)])
     slope = np.array([math.cos(a), -math.sin(a), 0.0])
