@@ -10,8 +10,9 @@
 !>   *OUTFLOW, BELOW=y                              model data: particles below y leave
 !>   *INFLOW, MATERIAL=name, LEVEL=y [, PPC=n]      in a step: data x1, x2 (3D: x1, z1, x2, z2)
 !>
-!> Rigid surfaces are walls too: *SURFACE, TYPE=SEGMENTS|PLANE (+ *RIGID BODY on a *NODE moved by
-!> *BOUNDARY) paired with the particles by *CONTACT PAIR with a blank first field
+!> Rigid surfaces are walls too: *SURFACE, TYPE=SEGMENTS (2D) or any 3D rigid surface (PLANE,
+!> REVOLUTION, ...) (+ *RIGID BODY on a *NODE moved by *BOUNDARY) paired with the particles by
+!> *CONTACT PAIR with a blank first field
 !> (attach_surface_walls appends them to the walls; src/mpm/mpm_walls.f90 evaluates them).
 !>
 !> A scene with *MPM GRID is a material-point scene: it has no *ELEMENT mesh; its
@@ -94,7 +95,8 @@ contains
                end if
                if (stype == 'ELEMENT') then
                   call blk%fail('*SURFACE, TYPE=ELEMENT in a material-point scene; expected TYPE=SEGMENTS ' // &
-                       '(2D) or TYPE=PLANE (3D): a rigid surface paired with the particles by *CONTACT PAIR', err)
+                       '(2D) or TYPE=PLANE, REVOLUTION, CYLINDER, FACETS (3D): a rigid surface paired with ' // &
+                       'the particles by *CONTACT PAIR', err)
                   return
                end if
             case ('MPM GRID')

@@ -14,7 +14,9 @@
 !>
 !> Accounting stays that of the half model: `mass_own` (the node mass before folding) weights the
 !> wall forces and the damping energy, and the plane's reaction is the momentum the fold hands the
-!> real material, −Σ [m_own (p + Δt f)/m − (p_own + Δt f_own)] / Δt.
+!> real material, −Σ [m_own (p + Δt f)/m − (p_own + Δt f_own)] / Δt. With two planes (a quarter
+!> model) the second fold meets nodes the first has already folded: their p_own is then the own
+!> share m_own/m of the node's momentum (own_share), so each plane reports its own reaction.
 module mpm_mirror
   use base_kinds, only: dp
   use mpm_scene, only: mpm_wall_t, wall_symmetry
@@ -103,7 +105,7 @@ contains
     do k = 1, size(mp%plane)
        f = mp%plane(k)
        ! the image gives the same mass and tangential parts, the opposite normal parts
-       exchange(a) = exchange(a) - (g%mom(a, f) + dt * g%force(a, f))
+       exchange(a) = exchange(a) - own_share(g, f) * (g%mom(a, f) + dt * g%force(a, f))
        g%mom(a, f) = 0
        g%force(a, f) = 0
     end do
@@ -115,8 +117,8 @@ contains
        p = g%mom(:, f) + reflect(g%mom(:, b), a)
        fo = g%force(:, f) + reflect(g%force(:, b), a)
        v = (p + dt * fo) / m
-       exchange = exchange + g%mass_own(f) * v - (g%mom(:, f) + dt * g%force(:, f)) &
-            + g%mass_own(b) * reflect(v, a) - (g%mom(:, b) + dt * g%force(:, b))
+       exchange = exchange + g%mass_own(f) * v - own_share(g, f) * (g%mom(:, f) + dt * g%force(:, f)) &
+            + g%mass_own(b) * reflect(v, a) - own_share(g, b) * (g%mom(:, b) + dt * g%force(:, b))
        g%mass(f) = m
        g%mass(b) = m
        g%mom(:, f) = p
@@ -147,6 +149,18 @@ contains
        g%mom(:, b) = reflect(p, a)
     end do
   end subroutine mirror_fold_momentum
+
+  !> The model's own share mass_own/mass of what a node holds before this fold: 1 (exactly) unless
+  !> an earlier plane folded its image in (the edge x = z = 0 of a quarter model), then the real
+  !> material's momentum there is that share of the node's, moving with the node's velocity.
+  pure real(dp) function own_share(g, i)
+    type(grid_t), intent(in) :: g
+    integer, intent(in) :: i
+    own_share = 1
+    if (abs(g%mass(i) - g%mass_own(i)) <= 0) return
+    own_share = 0
+    if (g%mass(i) > 0) own_share = g%mass_own(i) / g%mass(i)
+  end function own_share
 
   pure function reflect(v, axis) result(r)
     real(dp), intent(in) :: v(:)

@@ -11,9 +11,10 @@
 !> Particles that end an increment behind a wall (the wall's stencil is one cell wide) are put
 !> back onto it: `guard_particles`; the count is reported.
 !>
-!> Rigid-surface walls (mpm_wall_t%surface > 0: *SURFACE, TYPE=SEGMENTS/PLANE paired with the
-!> particles) are the element contact's geometry (contact_geometry's closest point: chains of
-!> lines and arcs, planes) and may move with their reference node. Their nodes are found again
+!> Rigid-surface walls (mpm_wall_t%surface > 0: a *SURFACE paired with the particles) are the
+!> element contact's geometry (contact_walls' closest point: 2D chains of lines and arcs; in 3D
+!> planes, facets and the CYLINDER/REVOLUTION profiles, so a conical hopper's revolved profile is
+!> one wall) and may move with their reference node. Their nodes are found again
 !> every increment (`surface_find_nodes`: gap <= 0 against the surface at t_n+1, each with the
 !> surface's normal there); the projection splits the velocity relative to the wall,
 !> v − v_w, so a node ends with at least the wall's normal velocity (`surface_node_velocity`).
@@ -22,7 +23,7 @@ module mpm_walls
   use mpm_scene, only: mpm_wall_t, wall_symmetry
   use mpm_grid, only: grid_t
   use model_surfaces, only: rigid_surface_t
-  use contact_geometry, only: surface_closest_point
+  use contact_walls, only: wall_closest_point
   implicit none
   private
 
@@ -241,7 +242,7 @@ contains
        if (.not. g%mass(i) > 0) cycle
        x = g%position(i)
        normal = 0
-       call surface_closest_point(surf, offset(1:nd), x(1:nd), gap, normal(1:nd), cp(1:nd))
+       call wall_closest_point(surf, offset(1:nd), x(1:nd), gap, normal(1:nd), cp(1:nd))
        if (gap > tol) cycle
        n = n + 1
        list(n) = i
@@ -322,7 +323,7 @@ contains
 
     do p = 1, nb
        normal = 0
-       call surface_closest_point(surf, offset(1:nd), x(p, :), gap, normal(1:nd), cp(1:nd))
+       call wall_closest_point(surf, offset(1:nd), x(p, :), gap, normal(1:nd), cp(1:nd))
        if (.not. gap < 0) cycle
        x(p, :) = cp(1:nd)
        vi = 0

@@ -7,7 +7,8 @@ kinds:
   column     K0 column (2D or 3D): sigma_xx/sigma_yy and sigma_zz/sigma_yy = nu/(1-nu) within 2 %,
              sigma_yy = -rho g (H - y) within 2 % as the mean over each layer of grid cells below
              0.8 H (the two particle rows of a cell carry an equal and opposite offset of ~200 Pa,
-             a sub-cell mode the grid does not see; its size is printed), exact mass balance
+             a sub-cell mode the grid does not see; its size is printed), the floor's reaction the
+             weight (1e-4) and every plane's normal to it, exact mass balance
   incline    block sliding on an inclined wall: a = g (sin a - mu cos a) within 2 %
   heap       collapsed c = 0 column: surface slope within 3 deg of phi
   mpi        the same hopper on 1 rank and twice on 2 ranks (--mpiexec): the 2-rank runs are
@@ -146,21 +147,35 @@ def column(args):
     check(worst_k < 0.02, f"K0: max |(sigma_h/sigma_v)/K0 - 1| = {worst_k:.2e} (K0 = {k0:.4f})")
     check(worst_s < 0.02, f"sigma_yy vs -rho g (H - y): max relative error {worst_s:.2e}")
     check(hist["ALLKE"][-1] < 1e-6 * max(hist["ALLIE"][-1], 1e-30), "column at rest (ALLKE << ALLIE)")
+    # every wall is a mirrored symmetry plane, the floor folded after the side planes: its reaction
+    # is the weight, and each plane's reaction is normal to it (main reported 2x and 6x the weight)
+    weight = hist["MASS"][-1] * grav
+    floor = -hist["WALLF2_FLOOR"][-1]
+    check(abs(floor / weight - 1) < 1e-4, f"floor reaction {floor:.3f} N = weight {weight:.3f} N")
+    for name in [n[len("WALLF1_"):] for n in hist.dtype.names if n.startswith("WALLF1_")]:
+        f = np.array([hist[f"WALLF{i}_{name}"][-1] for i in (1, 2, 3)])
+        check(np.sort(np.abs(f))[-2] <= 1e-9 * weight, f"wall {name}: reaction {f} normal to the plane")
     mass_balance(hist)
     paraview_check(base, len(x))
 
 
-def incline(args):
-    base, out, hist = run(args.bulkflow, args.scene, args.workdir)
-    check_report(out, ["walls", "gravity"], ["damping", "outflow", "inflow"])
-    a, mu, grav = math.radians(30.0), 0.2, 9.81
+def slide_acceleration(hist, what, a=math.radians(30.0), mu=0.2, grav=9.81):
+    """The centre of mass's acceleration down a 30 deg slope (+x, -y) from 0.1 s against
+    g (sin a - mu cos a) within 2 %; returns it, the slide velocity and the rows used."""
     t = hist["time"]
     vs = hist["VCM1"] * math.cos(a) - hist["VCM2"] * math.sin(a)
     m = t >= 0.1
     acc = np.polyfit(t[m], vs[m], 1)[0]
     expected = grav * (math.sin(a) - mu * math.cos(a))
     err = acc / expected - 1
-    check(abs(err) < 0.02, f"incline: a = {acc:.5f} m/s2, g(sin a - mu cos a) = {expected:.5f}, error {err:+.2e}")
+    check(abs(err) < 0.02, f"{what}: a = {acc:.5f} m/s2, g(sin a - mu cos a) = {expected:.5f}, error {err:+.2e}")
+    return acc, vs, m
+
+
+def incline(args):
+    base, out, hist = run(args.bulkflow, args.scene, args.workdir)
+    check_report(out, ["walls", "gravity"], ["damping", "outflow", "inflow"])
+    slide_acceleration(hist, "incline")
     mass_balance(hist)
 
 

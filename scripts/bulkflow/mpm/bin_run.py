@@ -30,21 +30,12 @@ def run_bin(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, label="",
     and the scene keywords."""
     text = bin_scene(**scene)
 
-    def make(base, meta, digest):
-        base.with_suffix(".inp").write_text(text)
-        t0 = time.perf_counter()
-        res = subprocess.run([exe, str(base.with_suffix(".inp")), "--output", str(base), "--quiet"],
-                             capture_output=True, text=True)
-        wall = time.perf_counter() - t0
-        if res.returncode != 0:
-            sys.stderr.write(res.stdout + res.stderr)
-            raise SystemExit(f"run failed: {base}.inp")
-        r = reduce_run(str(base), res.stdout, scene)
-        r.update(digest=digest, wall=wall)
-        meta.write_text(json.dumps(r, indent=1))
+    def reduce(base, run):
+        r = reduce_run(str(base), run["stdout"], scene)
+        r.update(digest=run["digest"], wall=run["wall"])
         return r
 
-    return cached_run(out_dir, f"bin_{label + '_' if label else ''}", text, reuse, make)
+    return cached_run(exe, out_dir, text, f"bin_{label + '_' if label else ''}", reduce, reuse)
 
 
 def reduce_run(base, stdout, scene):

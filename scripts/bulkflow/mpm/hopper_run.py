@@ -44,15 +44,15 @@ def run_hopper(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, ranks=
     """Write, run and reduce one hopper scene. `scene` are hopper_scene() keywords. Returns a dict:
     base (output base path), wall [s], psteps, particles, mdr (half model) and mdr_full [kg/s/m],
     mfi, v_out, rho_out (outlet path means of the last 3 frames) and the scene keywords."""
-    text = scene_text(**scene)
-    return cached_run(out_dir, f"hopper_{label + '_' if label else ''}", text, reuse,
-                      lambda base, meta, digest: _run_and_reduce(exe, base, meta, text, digest, ranks, scene))
+    return cached_run(exe, out_dir, scene_text(**scene), "hopper_" + (label + "_" if label else ""),
+                      lambda base, run: _reduce(base, run, scene), reuse, ranks)
 
 
-def cached_run(out_dir, prefix, text, reuse, make):
-    """The run of scene `text` named `prefix` + the hash of the text and MPM_REVISION in `out_dir`:
-    its recorded result (`<base>.json`) if it has the same hash and `reuse`, else make(base, meta,
-    digest), which runs it and writes meta."""
+def cached_run(exe, out_dir, text, prefix, reduce, reuse=True, ranks=1):
+    """Run the scene `text` as out_dir/<prefix><hash> unless a finished run of the same text (and
+    MPM_REVISION) is there; reduce(base, run) turns a fresh run (run: digest, base, wall [s],
+    psteps, particles, stdout: the solver's printout, not kept) into the dict kept in <base>.json
+    and returned."""
     digest = hashlib.sha256(f"mpm revision {MPM_REVISION}\n{text}".encode()).hexdigest()[:12]
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -65,10 +65,13 @@ def cached_run(out_dir, prefix, text, reuse, make):
             r = json.loads(meta.read_text())
             if r.get("digest") == digest:
                 return r
-        return make(base, meta, digest)
+        r = reduce(base, _run(exe, base, text, ranks, digest))
+        r.pop("stdout", None)
+        meta.write_text(json.dumps(r, indent=1))
+        return r
 
 
-def _run_and_reduce(exe, base, meta, text, digest, ranks, scene):
+def _run(exe, base, text, ranks, digest):
     scene_path = base.with_suffix(".inp")
     scene_path.write_text(text)
     cmd = [exe, str(scene_path), "--output", str(base), "--quiet"]
@@ -82,6 +85,10 @@ def _run_and_reduce(exe, base, meta, text, digest, ranks, scene):
         raise SystemExit(f"run failed: {scene_path}")
     steps = int(re.search(r"throughput (\d+) particle-steps", res.stdout).group(1))
     npart = int(re.search(r"(\d+) particles,", res.stdout).group(1))
+    return dict(digest=digest, base=str(base), wall=wall, psteps=steps, particles=npart, stdout=res.stdout)
+
+
+def _reduce(base, run, scene):
     kw = dict(RUN_DEFAULTS)
     kw.update(scene)
     theta, outlet = kw.get("theta", 30.0), kw.get("outlet", 0.25)
@@ -92,8 +99,6 @@ def _run_and_reduce(exe, base, meta, text, digest, ranks, scene):
     import h5py
     with h5py.File(str(base) + ".h5", "r") as f:
         op = outlet_path(frames(f, 3), cell, theta, outlet)
-    r = dict(digest=digest, base=str(base), wall=wall, psteps=steps, particles=npart, mdr=mdr,
-             mdr_full=2 * mdr, mfi=float(mfi), v_out=float(np.nanmean(op[:, 1])),
+    r = dict(run, mdr=mdr, mdr_full=2 * mdr, mfi=float(mfi), v_out=float(np.nanmean(op[:, 1])),
              rho_out=float(np.nanmean(op[:, 2])), scene=kw)
-    meta.write_text(json.dumps(r, indent=1))
     return r

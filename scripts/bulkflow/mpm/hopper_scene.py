@@ -49,6 +49,89 @@ def eps_cv_from_eta(eta_cv, eta_i=ETA_INITIAL):
     return math.log(eta_i / eta_cv)
 
 
+def material_lines(name, model="MC", density=1600.0, young=1.0e7, poisson=0.2, phi=20.0, psi_initial=15.0,
+                   eps_cv=0.2, psi_constant=None, dilation=True):
+    """The *MATERIAL block of the hopper fill (Table 4.2/4.3 by default; module doc): Mohr-Coulomb with
+    the dilation table (VUSDFLD), a constant dilation angle, the built-in *MOHR COULOMB (no dilation) or
+    the matched Drucker-Prager. Shared by the wedge (this module) and the cone (cone_scene.py)."""
+    lines = []
+    w = lines.append
+    w(f"*MATERIAL, NAME={name}")
+    w("*DENSITY")
+    w(f"{_num(density)}")
+    if model == "DP":
+        # linear Drucker-Prager from the Mohr-Coulomb parameters by the plane-strain match
+        w("*USER MATERIAL, CONSTANTS=6")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant or 0.0)}, 0., 1.")
+        w("*DEPVAR")
+        w("8")
+    elif psi_constant is not None:
+        w("*USER MATERIAL, CONSTANTS=16")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant)}, 0., 0., 0., 0.")
+        w("0., 0., 0., 0., 0., 1., 0., 0.")
+        w("*DEPVAR")
+        w("8")
+    elif dilation:
+        # props layout: umat/README.md (as inputs/demo/wedge_hopper_dilation.inp)
+        w("*USER MATERIAL, CONSTANTS=22")
+        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, 0., 0., 0., 0., 0.")
+        w("0., 0., 0., 0., 2., 1., 0., 0.")
+        w(f"{_num(phi)}, {_num(psi_initial)}, 0., {_num(phi)}, 0., {_num(eps_cv)}")
+        w("*DEPVAR")
+        w("8")
+        w("*USER DEFINED FIELD")
+    else:
+        w("*ELASTIC")
+        w(f"{_num(young)}, {_num(poisson)}")
+        w("*MOHR COULOMB")
+        w(f"{_num(phi)}, 0.")
+        w("*MOHR COULOMB HARDENING")
+        w("0., 0.")
+    return lines
+
+
+def step_lines(ramp, fill_time, discharge_time, field_frames, history_dt, gravity, inflow_lines=(),
+               discharge=True, discharge_frames=None):
+    """The steps of a hopper scene: FILL (outlet closed, gravity `gravity` -- the *DLOAD data line --
+    ramped by a smooth step, the scene's local damping) and DISCHARGE (damping off, the wall OUTLET
+    deleted, `inflow_lines` if any), each with particle frames (`discharge_frames` in the discharge
+    step if given) and history rows. Shared by the wedge
+    (this module) and the cone (cone_scene.py)."""
+    lines = []
+    w = lines.append
+    # Gravity that stays on: the ramp runs in total time, so the discharge step, which does not
+    # define gravity again, carries it on at full value (docs/keywords.md, "Prescribed conditions
+    # across steps"; with TIME=STEP TIME it would be held at the ramp's end value, the same here).
+    w("** gravity: ramped in the fill step, then on at full value (amplitude in total time)")
+    w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME")
+    w(f"0., 0., {ramp:g}, 1.")
+    w("*STEP, NAME=FILL")
+    w("Outlet closed: the fill settles under gravity")
+    w("*DYNAMIC, EXPLICIT")
+    w(f", {fill_time:g}")
+    w("*DLOAD, AMPLITUDE=RAMP")
+    w(gravity)
+    lines += _output_lines(field_frames, history_dt)
+    w("*END STEP")
+    if not discharge:
+        return lines
+    w("*STEP, NAME=DISCHARGE")
+    w("Outlet open: discharge" + (" with inflow at the top" if inflow_lines else ""))
+    w("*DYNAMIC, EXPLICIT")
+    w(f", {discharge_time:g}")
+    w("*MPM CONTROLS, DAMPING=0.")
+    w("*MPM WALL, NAME=OUTLET, OP=DELETE")
+    lines += list(inflow_lines)
+    lines += _output_lines(discharge_frames or field_frames, history_dt)
+    w("*END STEP")
+    return lines
+
+
+def _output_lines(field_frames, history_dt):
+    return [f"*OUTPUT, FIELD, NUMBER INTERVAL={field_frames}", "*ELEMENT OUTPUT", "S, SDV",
+            f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}", "*ENERGY OUTPUT"]
+
+
 def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_friction=5.0,
                  fill_time=1.0, ramp=0.6, discharge_time=3.0, inflow=True, fill_damping=0.1,
                  flip=0.99, cfl=0.3, shape="GIMP", field_frames=10, history_dt=0.01,
@@ -87,37 +170,9 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w(f"{hi[0]:.9f}, {hi[1]:.9f}")
     w(f"*MPM CONTROLS, FLIP={flip:g}, CFL={cfl:g}, DAMPING={fill_damping:g}")
     name = "DP-FILL" if model == "DP" else "MC-FILL"
-    w(f"*MATERIAL, NAME={name}")
-    w("*DENSITY")
-    w(f"{_num(density)}")
-    if model == "DP":
-        # linear Drucker-Prager from the Mohr-Coulomb parameters by the plane-strain match
-        w("*USER MATERIAL, CONSTANTS=6")
-        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant or 0.0)}, 0., 1.")
-        w("*DEPVAR")
-        w("8")
-    elif psi_constant is not None:
-        w("*USER MATERIAL, CONSTANTS=16")
-        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, {_num(psi_constant)}, 0., 0., 0., 0.")
-        w("0., 0., 0., 0., 0., 1., 0., 0.")
-        w("*DEPVAR")
-        w("8")
-    elif dilation:
-        # props layout: umat/README.md (as inputs/demo/wedge_hopper_dilation.inp)
-        w("*USER MATERIAL, CONSTANTS=22")
-        w(f"{_num(young)}, {_num(poisson)}, {_num(phi)}, 0., 0., 0., 0., 0.")
-        w("0., 0., 0., 0., 2., 1., 0., 0.")
-        w(f"{_num(phi)}, {_num(psi_initial)}, 0., {_num(phi)}, 0., {_num(eps_cv)}")
-        w("*DEPVAR")
-        w("8")
-        w("*USER DEFINED FIELD")
-    else:
-        w("*ELASTIC")
-        w(f"{_num(young)}, {_num(poisson)}")
-        w("*MOHR COULOMB")
-        w(f"{_num(phi)}, 0.")
-        w("*MOHR COULOMB HARDENING")
-        w("0., 0.")
+    lines += material_lines(name, model=model, density=density, young=young, poisson=poisson, phi=phi,
+                            psi_initial=psi_initial, eps_cv=eps_cv, psi_constant=psi_constant,
+                            dilation=dilation)
     w(f"*PARTICLES, MATERIAL={name}, PPC={ppc}, TYPE=POLYGON")
     for x, y in [(0.0, y0), (0.5 * outlet, y0), (xtop, ytop), (0.0, ytop)]:
         w(f"{x:.9f}, {y:.9f}")
@@ -129,39 +184,9 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu:.7f}")
     w(f"{lo[0]:.9f}, {y0:.9f}, {0.5 * outlet:.9f}, {y0:.9f}")
     w(f"*OUTFLOW, BELOW={out_level:.9f}")
-    # Gravity that stays on: the ramp runs in total time, so the discharge step, which does not
-    # define gravity again, carries it on at full value (docs/keywords.md, "Prescribed conditions
-    # across steps"; with TIME=STEP TIME it would be held at the ramp's end value, the same here).
-    w("** gravity: ramped in the fill step, then on at full value (amplitude in total time)")
-    w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME")
-    w(f"0., 0., {ramp:g}, 1.")
-    w("*STEP, NAME=FILL")
-    w("Outlet closed: the fill settles under gravity")
-    w("*DYNAMIC, EXPLICIT")
-    w(f", {fill_time:g}")
-    w("*DLOAD, AMPLITUDE=RAMP")
-    w(", GRAV, 9.81, 0., -1.")
-    w(f"*OUTPUT, FIELD, NUMBER INTERVAL={field_frames}")
-    w("*ELEMENT OUTPUT")
-    w("S, SDV")
-    w(f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}")
-    w("*ENERGY OUTPUT")
-    w("*END STEP")
-    w("*STEP, NAME=DISCHARGE")
-    w("Outlet open: discharge" + (" with inflow at the top" if inflow else ""))
-    w("*DYNAMIC, EXPLICIT")
-    w(f", {discharge_time:g}")
-    w(f"*MPM CONTROLS, DAMPING=0.")
-    w("*MPM WALL, NAME=OUTLET, OP=DELETE")
-    if inflow:
-        w(f"*INFLOW, MATERIAL={name}, LEVEL={ytop:.9f}, PPC={ppc}")
-        w(f"0., {xtop:.9f}")
-    w(f"*OUTPUT, FIELD, NUMBER INTERVAL={discharge_frames or field_frames}")
-    w("*ELEMENT OUTPUT")
-    w("S, SDV")
-    w(f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}")
-    w("*ENERGY OUTPUT")
-    w("*END STEP")
+    inflow_lines = [f"*INFLOW, MATERIAL={name}, LEVEL={ytop:.9f}, PPC={ppc}", f"0., {xtop:.9f}"] if inflow else []
+    lines += step_lines(ramp, fill_time, discharge_time, field_frames, history_dt, ", GRAV, 9.81, 0., -1.",
+                        inflow_lines, discharge_frames=discharge_frames)
     return "\n".join(lines) + "\n"
 
 

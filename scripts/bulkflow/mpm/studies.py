@@ -42,6 +42,7 @@ MODULE_STUDIES = {
     "mc-dp": "study_mc_dp",
     "parametric": "study_parametric",
     "bins": "study_bins",
+    "conical": "study_conical",
 }
 
 
