@@ -65,6 +65,8 @@ module mpm_scene
      real(dp) :: flip = 0.99_dp             !< PIC/FLIP blend α (1: FLIP, 0: PIC)
      real(dp) :: cfl = 0.3_dp               !< Δt = cfl h / max(c + |v|)
      real(dp) :: damping = 0                !< local non-viscous damping coefficient on the grid
+     !> *MPM SIDE FRICTION: Coulomb μw of the front and back walls a gap side_gap apart (2D; 0: off)
+     real(dp) :: side_friction = 0, side_gap = 0
      type(mpm_inflow_t) :: inflow
   end type mpm_step_t
 

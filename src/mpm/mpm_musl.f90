@@ -19,6 +19,7 @@ module mpm_musl
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
   use mpm_setup, only: mark_wall_nodes
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
+  use mpm_side_friction, only: side_friction_grid, side_friction_work
   use output_timer, only: timer_start, timer_stop
   use parallel_comm, only: comm_sum
   implicit none
@@ -113,6 +114,7 @@ contains
     call timer_start(fx%timers, fx%id(fx_grid))
     call grid_update(st, m%mpm%steps(s)%damping)
     call timer_stop(fx%timers, fx%id(fx_grid))
+    call side_friction_grid(m, st, fx)    ! *MPM SIDE FRICTION (returns at once without it)
     if (fx%active(fx_walls)) then
        call timer_start(fx%timers, fx%id(fx_walls))
        do k = 1, size(m%mpm%walls)
@@ -141,6 +143,7 @@ contains
        st%impulse_time = st%impulse_time + st%dt
        call timer_stop(fx%timers, fx%id(fx_walls))
     end if
+    call side_friction_work(m, st, fx)    ! its work on the velocity the walls left
 
     call timer_start(fx%timers, fx%id(fx_g2p))
     call grid_clear(st%nd * st%g%nn, st%g%mom)

@@ -10,7 +10,8 @@ module mpm_setup
   use model, only: model_t
   use mpm_scene, only: particle_region_t, region_box, region_polygon
   use mpm_state, only: mpm_state_t, mpm_effects_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
-       fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_output, n_fx, fx_names
+       fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_output, fx_side_friction, &
+       n_fx, fx_names
   use mpm_grid, only: grid_init
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow
   use mpm_shape, only: stencil_nodes_per_direction
@@ -131,6 +132,7 @@ contains
     do s = 1, m%n_steps
        if (m%mpm%steps(s)%inflow%on) fx%active(fx_inflow) = .true.
        if (m%mpm%steps(s)%damping > 0) fx%active(fx_damping) = .true.
+       if (m%mpm%steps(s)%side_friction > 0) fx%active(fx_side_friction) = .true.
        if (allocated(m%steps(s)%gravity)) then
           if (size(m%steps(s)%gravity) > 0) fx%active(fx_gravity) = .true.
        end if

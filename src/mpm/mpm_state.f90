@@ -23,9 +23,10 @@ module mpm_state
   ! timer only for what is active, shares in the report); MPM's own list keeps the FEM one intact.
   integer, parameter, public :: fx_p2g = 1, fx_grid = 2, fx_g2p = 3, fx_kinematics = 4, fx_material = 5, &
        fx_user_field = 6, fx_gravity = 7, fx_damping = 8, fx_walls = 9, fx_outflow = 10, fx_inflow = 11, &
-       fx_output = 12, n_fx = 12
+       fx_output = 12, fx_side_friction = 13, n_fx = 13
   character(len=16), parameter, public :: fx_names(n_fx) = [character(len=16) :: 'p2g', 'grid update', 'g2p', &
-       'kinematics', 'material', 'user field', 'gravity', 'damping', 'walls', 'outflow', 'inflow', 'output']
+       'kinematics', 'material', 'user field', 'gravity', 'damping', 'walls', 'outflow', 'inflow', 'output', &
+       'side friction']
 
   type, public :: mpm_effects_t
      logical :: active(n_fx) = .false.
@@ -71,6 +72,10 @@ module mpm_state
      real(dp), allocatable :: wall_force_row(:, :)   !< the last history row's (mean) wall forces
      real(dp) :: impulse_time = 0
      logical, allocatable :: on_wall(:)              !< grid nodes of the walls active in this step
+     real(dp), allocatable :: side_capacity(:)       !< (nn) front/back wall friction capacity (mpm_side_friction)
+     !> force of the material on the front and back walls together in the last increment (mpm_side_friction)
+     real(dp) :: side_force(3) = 0
+     real(dp), allocatable :: side_impulse(:, :)     !< (2, nn) its impulse on each node's own material
      !> (3, model%n_rigid_surfaces) displacement of each rigid surface's reference node (t_n+1
      !> once the walls of the increment are done) and its velocity over the increment
      real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
