@@ -19,7 +19,8 @@ contains
   !> history has the columns SIDEF1, SIDEF2 and the summary its force.
   pure logical function side_friction_on(m)
     type(model_t), intent(in) :: m
-    side_friction_on = any(m%mpm%steps(:)%side_friction > 0)
+    side_friction_on = .false.
+    if (allocated(m%mpm%steps)) side_friction_on = any(m%mpm%steps(:)%side_friction > 0)
   end function side_friction_on
 
   !> A field frame: every rank writes its own blocks (collective; rows in rank order).
