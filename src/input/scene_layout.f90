@@ -48,7 +48,7 @@ contains
     case ('DYNAMIC', 'DLOAD', 'DSLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'FIXED MASS SCALING', &
           'STOP CONDITION', 'INFLOW', 'TEMPERATURE')
        keyword_kind = kw_step_only
-    case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR', 'MPM CONTROLS', 'MPM WALL', 'TIME POINTS')
+    case ('AMPLITUDE', 'BOUNDARY', 'CONTACT PAIR', 'MPM CONTROLS', 'MPM WALL', 'TIME POINTS', 'MPM SIDE FRICTION')
        keyword_kind = kw_anywhere
     case ('FRICTION')
        keyword_kind = kw_interaction_option

@@ -2,6 +2,7 @@
 !>
 !>   *MPM GRID, CELL=h [, SHAPE=GIMP|LINEAR]        data: lo corner; hi corner (2 or 3 values)
 !>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a] [, SORT=n]   model data or in a step; carries over
+!>   *MPM SIDE FRICTION, GAP=t, FRICTION=μw         2D, model data or in a step; carries over
 !>   *PARTICLES, MATERIAL=name [, PPC=n] [, TYPE=BOX|POLYGON] [, Z1=, Z2=] [, VX=, VY=, VZ=]
 !>                                                  data: BOX lo; hi  |  POLYGON x, y per line
 !>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, OP=DELETE]
@@ -28,6 +29,7 @@ module scene_mpm
        shape_gimp, region_box, region_polygon, wall_friction, wall_symmetry, wall_name_length
   use scene_layout, only: scene_layout_t
   use scene_materials, only: find_material
+  use scene_mpm_side, only: read_side_friction
   use scene_util, only: itoa, rtoa, get_real, expect_lines, expect_fields, last_field, where_text, &
        check_name
   implicit none
@@ -41,7 +43,7 @@ contains
   pure logical function mpm_keyword(name)
     character(len=*), intent(in) :: name
     select case (name)
-    case ('MPM GRID', 'MPM CONTROLS', 'PARTICLES', 'MPM WALL', 'OUTFLOW', 'INFLOW')
+    case ('MPM GRID', 'MPM CONTROLS', 'PARTICLES', 'MPM WALL', 'OUTFLOW', 'INFLOW', 'MPM SIDE FRICTION')
        mpm_keyword = .true.
     case default
        mpm_keyword = .false.
@@ -135,6 +137,8 @@ contains
            select case (blk%name)
            case ('MPM CONTROLS')
               call read_controls(blk, carry, err)
+           case ('MPM SIDE FRICTION')
+              call read_side_friction(blk, mpm%ndim, carry, err)
            case ('PARTICLES')
               call read_particles(blk, model, err)
            case ('MPM WALL')
@@ -162,6 +166,8 @@ contains
               select case (blk%name)
               case ('MPM CONTROLS')
                  call read_controls(blk, carry, err)
+              case ('MPM SIDE FRICTION')
+                 call read_side_friction(blk, mpm%ndim, carry, err)
               case ('MPM WALL')
                  call read_wall(blk, mpm, s, nsteps, err)
               case ('INFLOW')

@@ -214,7 +214,7 @@ contains
             call read_output_option(blk, model, c%outputs, err)
          case ('AMPLITUDE', 'TIME POINTS')
             ! defined globally by scene_amplitudes and scene_time_points
-         case ('MPM CONTROLS', 'MPM WALL', 'INFLOW')
+         case ('MPM CONTROLS', 'MPM WALL', 'INFLOW', 'MPM SIDE FRICTION')
             ! material-point keywords: read by scene_mpm
          case default
             call blk%fail('*' // blk%name // ' cannot stand inside a step; expected step keywords ' // &

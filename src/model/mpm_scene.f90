@@ -68,6 +68,8 @@ module mpm_scene
      !> particles sorted by cell every `sort` increments, P2G and remap particle by particle
      !> (src/mpm/mpm_sort.f90); 0: block order and node-major sums (the results of before, bit for bit)
      integer :: sort = 0
+     !> *MPM SIDE FRICTION: Coulomb μw of the front and back walls a gap side_gap apart (2D; 0: off)
+     real(dp) :: side_friction = 0, side_gap = 0
      type(mpm_inflow_t) :: inflow
   end type mpm_step_t
 

@@ -21,6 +21,7 @@ module mpm_musl
   use mpm_setup, only: mark_wall_nodes
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
   use output_effects, only: effects_t
+  use mpm_side_friction, only: side_friction_grid, side_friction_work
   use parallel_comm, only: comm_sum
   implicit none
   private
@@ -124,6 +125,7 @@ contains
     call fx%start(fx_grid)
     call grid_update(st, m%mpm%steps(s)%damping)
     call fx%stop(fx_grid)
+    call side_friction_grid(m, st, fx)    ! *MPM SIDE FRICTION (returns at once without it)
     if (fx%active(fx_walls)) then
        call fx%start(fx_walls)
        do k = 1, size(m%mpm%walls)
@@ -152,6 +154,7 @@ contains
        st%impulse_time = st%impulse_time + st%dt
        call fx%stop(fx_walls)
     end if
+    call side_friction_work(m, st, fx)    ! its work on the velocity the walls left
 
     call fx%start(fx_g2p)
     call grid_clear(st%nd * st%g%nn, st%g%mom)

@@ -16,6 +16,14 @@ module mpm_report
 
 contains
 
+  !> Does a step of the scene have front and back wall friction (*MPM SIDE FRICTION)? Then the
+  !> history has the columns SIDEF1, SIDEF2 and the summary its force.
+  pure logical function side_friction_on(m)
+    type(model_t), intent(in) :: m
+    side_friction_on = .false.
+    if (allocated(m%mpm%steps)) side_friction_on = any(m%mpm%steps(:)%side_friction > 0)
+  end function side_friction_on
+
   !> A field frame: every rank writes its own blocks (collective; rows in rank order).
   subroutine write_frame(m, st, wr, step, step_time)
     type(model_t), intent(in) :: m
@@ -37,7 +45,7 @@ contains
     integer :: k, n, j
 
     n = size(m%mpm%walls)
-    allocate (columns(size(fixed) + 3 * n))
+    allocate (columns(size(fixed) + 3 * n + merge(2, 0, side_friction_on(m))))
     columns(1:size(fixed)) = fixed
     j = size(fixed)
     do k = 1, n
@@ -46,6 +54,7 @@ contains
        columns(j + 3) = 'WALLF3_' // trim(m%mpm%walls(k)%name)
        j = j + 3
     end do
+    if (side_friction_on(m)) columns(j + 1:j + 2) = [character(len=32) :: 'SIDEF1', 'SIDEF2']
   end subroutine history_columns
 
   !> Kinetic and internal energy (global sums) of the particles.
@@ -110,7 +119,7 @@ contains
     mdr = 0
     if (st%total_time > last_time) mdr = (mass_out - last_out) / (st%total_time - last_time)
     etotal = st%e_kinetic + st%e_internal + st%e_walls + st%e_damping + g(11) - st%e_in - g(10)
-    allocate (row(24 + 3 * size(m%mpm%walls)))
+    allocate (row(24 + 3 * size(m%mpm%walls) + merge(2, 0, side_friction_on(m))))
     row(1:24) = [st%total_time, real(st%step, dp), st%step_time, real(st%increment, dp), g(8), mass, &
          st%mass_in, mass_out, mdr, st%mass_initial + st%mass_in - mass_out - mass, st%e_kinetic, &
          st%e_internal, g(10), st%e_walls, st%e_damping, etotal, xcm, vcm, top(1), g(12)]
@@ -124,6 +133,7 @@ contains
        row(j + 1:j + 3) = st%wall_force_row(:, k)
        j = j + 3
     end do
+    if (side_friction_on(m)) row(j + 1:j + 2) = st%side_force(1:2)
     if (allocated(st%wall_impulse)) st%wall_impulse = 0
     st%impulse_time = 0
     call history_row(hist, row)
@@ -173,6 +183,8 @@ contains
     do k = 1, size(m%mpm%walls)
        write (output_unit, '(a,3es13.5)') '  wall ' // trim(m%mpm%walls(k)%name) // ' force:', st%wall_force_row(:, k)
     end do
+    if (side_friction_on(m)) write (output_unit, '(a,2es13.5)') '  front and back walls (side friction) force:', &
+         st%side_force(1:2)
     if (g(6) > 0) write (output_unit, '(a,i0)') '  particles put back onto walls: ', nint(g(6))
     rate = g(7) / max(st%loop_seconds, 1.0e-9_dp)
     write (output_unit, '(a,i0,a,es11.4,a,f10.3,a,i0,a,es11.4,a)') '  throughput ', nint(g(7), int64), &

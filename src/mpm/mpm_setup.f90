@@ -10,7 +10,7 @@ module mpm_setup
   use model, only: model_t
   use mpm_scene, only: particle_region_t, region_box, region_polygon
   use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
-       fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow
+       fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_side_friction
   use output_effects, only: effects_t
   use mpm_grid, only: grid_init
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow
@@ -123,16 +123,18 @@ contains
   subroutine setup_effects(m, fx)
     type(model_t), intent(in) :: m
     type(effects_t), intent(inout) :: fx
-    logical :: inflow, damping, gravity
+    logical :: inflow, damping, gravity, side
     integer :: s
 
     inflow = .false.
     damping = .false.
     gravity = .false.
+    side = .false.
     do s = 1, m%n_steps
        inflow = inflow .or. m%mpm%steps(s)%inflow%on
        damping = damping .or. m%mpm%steps(s)%damping > 0
        if (allocated(m%steps(s)%gravity)) gravity = gravity .or. size(m%steps(s)%gravity) > 0
+       side = side .or. m%mpm%steps(s)%side_friction > 0
     end do
     call fx%declare(fx_p2g, 'p2g', active=.true.)
     call fx%declare(fx_grid, 'grid update', active=.true.)
@@ -145,6 +147,7 @@ contains
     call fx%declare(fx_walls, 'walls', active=size(m%mpm%walls) > 0)
     call fx%declare(fx_outflow, 'outflow', active=m%mpm%outflow)
     call fx%declare(fx_inflow, 'inflow', active=inflow)
+    call fx%declare(fx_side_friction, 'side friction', active=side)
   end subroutine setup_effects
 
   !> A regular lattice of ppc particles per cell and direction (aligned with the grid), kept

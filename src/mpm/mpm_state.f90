@@ -23,7 +23,8 @@ module mpm_state
   ! are the run skeleton's). A new effect: an id here and its declare line in mpm_setup.
   integer, parameter, public :: fx_p2g = first_technique_effect, fx_grid = fx_p2g + 1, fx_g2p = fx_p2g + 2, &
        fx_kinematics = fx_p2g + 3, fx_material = fx_p2g + 4, fx_user_field = fx_p2g + 5, fx_gravity = fx_p2g + 6, &
-       fx_damping = fx_p2g + 7, fx_walls = fx_p2g + 8, fx_outflow = fx_p2g + 9, fx_inflow = fx_p2g + 10
+       fx_damping = fx_p2g + 7, fx_walls = fx_p2g + 8, fx_outflow = fx_p2g + 9, fx_inflow = fx_p2g + 10, &
+       fx_side_friction = fx_p2g + 11
 
   !> Everything the run keeps. Per-rank partial values (sum over ranks when reported) are
   !> marked "rank"; the rest is the same on every rank.
@@ -63,6 +64,10 @@ module mpm_state
      real(dp), allocatable :: wall_force_row(:, :)   !< the last history row's (mean) wall forces
      real(dp) :: impulse_time = 0
      logical, allocatable :: on_wall(:)              !< grid nodes of the walls active in this step
+     real(dp), allocatable :: side_capacity(:)       !< (nn) front/back wall friction capacity (mpm_side_friction)
+     !> force of the material on the front and back walls together in the last increment (mpm_side_friction)
+     real(dp) :: side_force(3) = 0
+     real(dp), allocatable :: side_impulse(:, :)     !< (2, nn) its impulse on each node's own material
      !> (3, model%n_rigid_surfaces) displacement of each rigid surface's reference node (t_n+1
      !> once the walls of the increment are done) and its velocity over the increment
      real(dp), allocatable :: rigid_u(:, :), rigid_v(:, :)
