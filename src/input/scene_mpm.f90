@@ -2,6 +2,7 @@
 !>
 !>   *MPM GRID, CELL=h [, SHAPE=GIMP|LINEAR]        data: lo corner; hi corner (2 or 3 values)
 !>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a]   model data or in a step; carries over
+!>     [, DECOMPOSITION=REPLICATED|SPATIAL] [, REBALANCE=r]   model data only (MPI ranks)
 !>   *PARTICLES, MATERIAL=name [, PPC=n] [, TYPE=BOX|POLYGON] [, Z1=, Z2=] [, VX=, VY=, VZ=]
 !>                                                  data: BOX lo; hi  |  POLYGON x, y per line
 !>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, OP=DELETE]
@@ -24,7 +25,8 @@ module scene_mpm
   use keyword_reader, only: keyword_deck_t, keyword_block_t, data_line_t
   use model, only: model_t
   use mpm_scene, only: mpm_scene_t, particle_region_t, mpm_wall_t, mpm_step_t, shape_linear, &
-       shape_gimp, region_box, region_polygon, wall_friction, wall_symmetry, wall_name_length
+       shape_gimp, region_box, region_polygon, wall_friction, wall_symmetry, wall_name_length, &
+       decomposition_replicated, decomposition_spatial
   use scene_layout, only: scene_layout_t
   use scene_materials, only: find_material
   use scene_util, only: itoa, rtoa, get_real, expect_lines, expect_fields, last_field, where_text, &
@@ -133,6 +135,7 @@ contains
            select case (blk%name)
            case ('MPM CONTROLS')
               call read_controls(blk, carry, err)
+              if (.not. err%raised) call read_decomposition(blk, mpm, err)
            case ('PARTICLES')
               call read_particles(blk, model, err)
            case ('MPM WALL')
@@ -160,6 +163,8 @@ contains
               select case (blk%name)
               case ('MPM CONTROLS')
                  call read_controls(blk, carry, err)
+                 if (.not. err%raised .and. (blk%has_param('DECOMPOSITION') .or. blk%has_param('REBALANCE'))) &
+                      call blk%fail('DECOMPOSITION/REBALANCE in a step; expected them in the model data', err)
               case ('MPM WALL')
                  call read_wall(blk, mpm, s, nsteps, err)
               case ('INFLOW')
@@ -295,7 +300,7 @@ contains
     type(error_t), intent(inout) :: err
     real(dp) :: flip, cfl, damping
 
-    call blk%check_params([character(len=8) :: 'FLIP', 'CFL', 'DAMPING'], err)
+    call blk%check_params([character(len=13) :: 'FLIP', 'CFL', 'DAMPING', 'DECOMPOSITION', 'REBALANCE'], err)
     if (.not. err%raised) call blk%get_real('FLIP', flip, err, default=c%flip, minimum=0.0_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('CFL', cfl, err, default=c%cfl, minimum=1.0e-3_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('DAMPING', damping, err, default=c%damping, minimum=0.0_dp, &
@@ -306,6 +311,24 @@ contains
     c%cfl = cfl
     c%damping = damping
   end subroutine read_controls
+
+  !> The run's grid decomposition over MPI ranks (mpm_domain) and its re-partition threshold.
+  subroutine read_decomposition(blk, mpm, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(mpm_scene_t), intent(inout) :: mpm
+    type(error_t), intent(inout) :: err
+    character(len=:), allocatable :: kind
+    real(dp) :: rebalance
+
+    call blk%get_string('DECOMPOSITION', kind, err, default=trim(merge('SPATIAL   ', 'REPLICATED', &
+         mpm%decomposition == decomposition_spatial)), choices=[character(len=10) :: &
+         'REPLICATED', 'SPATIAL'])
+    if (.not. err%raised) call blk%get_real('REBALANCE', rebalance, err, default=mpm%rebalance, minimum=0.0_dp)
+    if (err%raised) return
+    mpm%rebalance = rebalance
+    mpm%decomposition = decomposition_replicated
+    if (kind == 'SPATIAL') mpm%decomposition = decomposition_spatial
+  end subroutine read_decomposition
 
   subroutine material_param(blk, model, k, err)
     type(keyword_block_t), intent(in) :: blk

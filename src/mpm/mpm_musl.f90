@@ -21,6 +21,7 @@ module mpm_musl
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
   use output_timer, only: timer_start, timer_stop
   use parallel_comm, only: comm_sum
+  use mpm_halo, only: halo_sum_p2g, halo_sum_momentum, owned_mass, sum_increment_accounts
   implicit none
   private
 
@@ -92,21 +93,33 @@ contains
     type(mpm_state_t), intent(inout) :: st
     type(mpm_effects_t), intent(inout) :: fx
     integer :: ib, k, s
+    real(dp) :: e_walls0, e_damping0
 
     s = st%step
+    e_walls0 = st%e_walls
+    e_damping0 = st%e_damping
     call timer_start(fx%timers, fx%id(fx_p2g))
     call grid_reset_sums(st%g)
     do ib = 1, st%nblocks
        call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
        call p2g(st, st%blocks(ib))
     end do
-    if (st%nranks > 1) call reduce_grid(st, .true.)
+    if (st%dom%on) then
+       call halo_sum_p2g(st)
+    else if (st%nranks > 1) then
+       call reduce_grid(st, .true.)
+    end if
     st%g%mass_own = st%g%mass
     st%wall_force = 0
     do k = 1, size(m%mpm%walls)
-       if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) &
-            call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k))
+       if (.not. (st%mirrored(k) .and. m%mpm%walls(k)%active(s))) cycle
+       if (st%dom%on) then
+          call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k), st%dom%owned)
+       else
+          call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k))
+       end if
     end do
+    if (st%dom%on) call owned_mass(st)
     call timer_stop(fx%timers, fx%id(fx_p2g))
 
     if (fx%active(fx_walls) .and. m%n_rigid_surfaces > 0) call surface_walls_at_new_time(m, st)
@@ -127,6 +140,7 @@ contains
             end if
           end associate
        end do
+       if (st%dom%on) call sum_increment_accounts(st, e_walls0, e_damping0)
        ! the work of the moving walls on the material, −F·v_w Δt (ALLWK; the grid and so the
        ! forces are the same on every rank: counted on rank 0)
        if (st%rank == 0) then
@@ -140,6 +154,8 @@ contains
        st%wall_impulse = st%wall_impulse + st%dt * st%wall_force
        st%impulse_time = st%impulse_time + st%dt
        call timer_stop(fx%timers, fx%id(fx_walls))
+    else if (st%dom%on) then
+       call sum_increment_accounts(st, e_walls0, e_damping0)
     end if
 
     call timer_start(fx%timers, fx%id(fx_g2p))
@@ -147,7 +163,11 @@ contains
     do ib = 1, st%nblocks
        call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
     end do
-    if (st%nranks > 1) call reduce_grid(st, .false.)
+    if (st%dom%on) then
+       call halo_sum_momentum(st)
+    else if (st%nranks > 1) then
+       call reduce_grid(st, .false.)
+    end if
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
     end do

@@ -24,6 +24,8 @@ module mpm_run
   use mpm_musl, only: step_gravity, musl_transfer
   use mpm_stress_update, only: stress_update
   use mpm_flow, only: guard_particles, outflow, inflow
+  use mpm_migrate, only: domain_increment_end
+  use mpm_domain, only: domain_build
   use mpm_output, only: mpm_writer_t, mpm_writer_frame_count, mpm_field_request_t
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
   use output_timer, only: timer_start, timer_stop
@@ -67,6 +69,8 @@ contains
           call timer_stop(fx%timers, fx%id(fx_inflow))
        end if
     end if
+    ! spatial decomposition: particles to the rank of their new position, re-partition if due
+    if (st%dom%on) call domain_increment_end(m, st)
   end subroutine mpm_increment
 
   ! ------------------------------------------------------------------------------ checkpoint hooks
@@ -116,6 +120,8 @@ contains
     sv%frames = 0
     if (st%rank == 0) sv%frames = mpm_writer_frame_count(wr)
     sv%rows = history_row_count(hist)
+    if (st%dom%on) allocate (sv%domain(1 + 6 * st%nranks), source=[st%dom%rebalances, &
+         reshape(st%dom%box, [6 * st%nranks])])
     call mpm_checkpoint_save(base, st%comm, m, st%blocks, st%nblocks, sv)
   end subroutine mpm_save
 
@@ -170,5 +176,10 @@ contains
     st%step_increment = sv%step_increment
     last_row_time = sv%last_row_time
     last_row_out = sv%last_row_out
+    ! the boxes the checkpointed particles were in (a re-partition may have moved them)
+    if (st%dom%on) then
+       st%dom%rebalances = sv%domain(1)
+       call domain_build(st%dom, reshape(sv%domain(2:), [2, 3, st%nranks]))
+    end if
   end subroutine mpm_resume
 end module mpm_run

@@ -8,7 +8,8 @@ module mpm_setup
   use error_report, only: raise_error
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
-  use mpm_scene, only: particle_region_t, region_box, region_polygon
+  use mpm_scene, only: particle_region_t, region_box, region_polygon, decomposition_spatial
+  use mpm_migrate, only: decompose_initial
   use mpm_state, only: mpm_state_t, mpm_effects_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
        fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_output, n_fx, fx_names
   use mpm_grid, only: grid_init
@@ -49,8 +50,9 @@ contains
       end do
       st%mass_cutoff = 1.0e-9_dp * maxval([(maxval(st%blocks(k)%mass), k = 1, st%nblocks)])
       st%n_initial = sum(st%blocks(1:st%nblocks)%count)
-      ! every rank made all blocks (same order); each keeps every nranks-th one
-      if (st%nranks > 1) then
+      ! every rank made all blocks (same order); each keeps every nranks-th one (the spatial
+      ! decomposition keeps the particles of its box instead, once the mirrors are known)
+      if (st%nranks > 1 .and. m%mpm%decomposition /= decomposition_spatial) then
          s = 0
          do k = 1, st%nblocks
             if (mod(k - 1, st%nranks) /= st%rank) cycle
@@ -81,6 +83,8 @@ contains
          ! model's would be (the fold leaves them symmetric)
          if (st%mirrored(k)) st%wall_nodes(k)%nodes = [integer ::]
       end do
+      if (st%nranks > 1 .and. m%mpm%decomposition == decomposition_spatial) &
+           call decompose_initial(m, st, m%mpm%rebalance)
     end associate
     call setup_effects(m, fx)
   end subroutine mpm_setup_run
