@@ -15,6 +15,8 @@
 !> does the grid update and the walls itself; particles never migrate. Inflow particles are
 !> made by rank 0. Sums over ranks are in rank order: results are deterministic for a given
 !> number of ranks and differ from 1 rank by round-off only. Output: every rank writes its own blocks.
+!> With *MPM CONTROLS, DECOMPOSITION=SPATIAL the grid is decomposed instead (mpm_domain: boxes,
+!> halo sums in mpm_halo, particle migration and re-partition at the increment's end in mpm_migrate).
 !> Checkpoint and restart: src/mpm/mpm_checkpoint.f90.
 module mpm_run
   use base_kinds, only: dp
