@@ -13,6 +13,8 @@
 !> * Plan: per neighbour, the held nodes it owns (this rank's partial sums go there, the totals
 !>   come back) and the owned nodes it holds (its partials come in, the totals go out), both in
 !>   ascending node index, derived alike on both sides from the boxes: messages carry values only.
+!>   Node numbers of the plan and the owned mask are those of the rank's grid, the held box
+!>   (mpm_grid's offset = held_lo).
 module mpm_domain
   use base_kinds, only: dp
   implicit none
@@ -26,7 +28,8 @@ module mpm_domain
      integer :: gl = 0, gh = 0           !< ghost node layers below / above a box
      integer, allocatable :: box(:, :, :)   !< (2, 3, 0:nranks − 1) cell range [lo, hi] (0-based)
      integer :: held_lo(3) = 0, held_hi(3) = 0   !< this rank's held node range (0-based)
-     logical, allocatable :: owned(:)    !< (nn) node owned by this rank
+     integer :: nl(3) = 0                !< nodes per direction of the held box (the rank's grid)
+     logical, allocatable :: owned(:)    !< (nodes of the held box) node owned by this rank
      integer, allocatable :: nbr(:)      !< neighbour ranks, ascending
      integer, allocatable :: send_first(:), send_nodes(:)   !< per neighbour: held nodes it owns
      integer, allocatable :: recv_first(:), recv_nodes(:)   !< per neighbour: owned nodes it holds
@@ -152,8 +155,9 @@ contains
     logical, allocatable :: is_shared(:)
 
     d%box = box
-    nn = product(d%n)
     call held_range(d, d%rank, d%held_lo, d%held_hi)
+    d%nl = max(0, d%held_hi - d%held_lo + 1)
+    nn = product(d%nl)
     if (allocated(d%owned)) deallocate (d%owned)
     allocate (d%owned(nn), is_shared(nn))
     d%owned = .false.
@@ -162,7 +166,7 @@ contains
     do k = olo(3), ohi(3)
        do j = olo(2), ohi(2)
           do i = olo(1), ohi(1)
-             d%owned(1 + i + d%n(1) * (j + d%n(2) * k)) = .true.
+             d%owned(local_node(i, j, k)) = .true.
           end do
        end do
     end do
@@ -203,7 +207,8 @@ contains
        d%shared(l) = node
     end do
   contains
-    !> Node indices of the node box lo..hi (0-based, inclusive), ascending; none when empty.
+    !> Node indices (this rank's grid) of the node box lo..hi (0-based, whole grid, inclusive,
+    !> inside the held box), ascending; none when empty.
     function box_nodes(lo, hi) result(list)
       integer, intent(in) :: lo(3), hi(3)
       integer, allocatable :: list(:)
@@ -214,11 +219,17 @@ contains
          do b = lo(2), hi(2)
             do a = lo(1), hi(1)
                m = m + 1
-               list(m) = 1 + a + d%n(1) * (b + d%n(2) * c)
+               list(m) = local_node(a, b, c)
             end do
          end do
       end do
     end function box_nodes
+
+    !> This rank's grid's node of the whole grid's node (a, b, c) (0-based, inside the held box).
+    pure integer function local_node(a, b, c)
+      integer, intent(in) :: a, b, c
+      local_node = 1 + (a - d%held_lo(1)) + d%nl(1) * ((b - d%held_lo(2)) + d%nl(2) * (c - d%held_lo(3)))
+    end function local_node
   end subroutine domain_build
 
   !> Owned node range of rank r (0-based, inclusive; empty: hi < lo).

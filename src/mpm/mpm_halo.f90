@@ -11,13 +11,16 @@ module mpm_halo
   use base_kinds, only: dp
   use mpm_state, only: mpm_state_t
   use mpm_domain, only: domain_t
-  use mpm_grid, only: grid_t
+  use mpm_grid, only: grid_t, grid_init_box, grid_node_count
+  use mpm_particles, only: particle_block_t
+  use error_report, only: raise_error
   use parallel_exchange, only: exchange_neighbours
   use parallel_comm, only: comm_sum
   implicit none
   private
 
   public :: halo_sum_p2g, halo_sum_momentum, owned_mass, sum_increment_accounts, owned_grid
+  public :: domain_regrid, local_corners, whole_grid_shape
 
 contains
 
@@ -161,23 +164,72 @@ contains
     type(mpm_state_t), intent(in) :: st
     type(grid_t), intent(out) :: gw
     real(dp), allocatable :: buf(:)
-    integer :: nn, nd, i
+    integer :: nn, nd, i, j, idx(3), r
 
-    nn = st%g%nn
+    gw = whole_grid_shape(st)
+    nn = gw%nn
     nd = st%nd
-    gw%ndim = st%g%ndim
-    gw%n = st%g%n
-    gw%nn = nn
-    gw%lo = st%g%lo
-    gw%h = st%g%h
     allocate (buf(nn * (1 + nd)), source=0.0_dp)
-    do i = 1, nn
+    do i = 1, st%g%nn
        if (.not. st%dom%owned(i)) cycle
-       buf(i) = st%g%mass(i)
-       buf(nn + nd * (i - 1) + 1:nn + nd * i) = st%g%v_new(:, i)
+       ! the whole grid's node of this rank's node i
+       r = i - 1
+       idx(1) = mod(r, st%g%n(1))
+       r = r / st%g%n(1)
+       idx(2) = mod(r, st%g%n(2))
+       idx(3) = r / st%g%n(2)
+       idx = idx + st%g%offset
+       j = 1 + idx(1) + gw%n(1) * (idx(2) + gw%n(2) * idx(3))
+       buf(j) = st%g%mass(i)
+       buf(nn + nd * (j - 1) + 1:nn + nd * j) = st%g%v_new(:, i)
     end do
     call comm_sum(st%comm, buf)
     allocate (gw%mass(nn), source=buf(1:nn))
     allocate (gw%v_new(nd, nn), source=reshape(buf(nn + 1:), [nd, nn]))
   end subroutine owned_grid
+
+  !> The whole grid's sizes and position (no node arrays): what the field output describes.
+  function whole_grid_shape(st) result(gw)
+    type(mpm_state_t), intent(in) :: st
+    type(grid_t) :: gw
+    gw%ndim = st%g%ndim
+    gw%n = st%dom%n
+    gw%nn = int(grid_node_count(gw%n))
+    gw%lo = st%g%lo
+    gw%h = st%g%h
+  end function whole_grid_shape
+
+  !> This rank's grid becomes its held box (mpm_domain: after a (re-)partition): node arrays for
+  !> the held nodes only. The walls' node lists and mirrors must be found again on it (mpm_setup).
+  subroutine domain_regrid(st)
+    type(mpm_state_t), intent(inout) :: st
+    real(dp) :: lo(3), h
+
+    lo = st%g%lo
+    h = st%g%h
+    call grid_init_box(st%g, st%nd, lo, h, st%dom%held_lo, st%dom%nl)
+  end subroutine domain_regrid
+
+  !> The block's stencil corners (block_stencil's, numbered on the whole grid) in this rank's
+  !> grid's numbering. A corner outside the held box is a decomposition error (a particle not
+  !> in this rank's box), reported rather than written out of bounds.
+  subroutine local_corners(st, b)
+    type(mpm_state_t), intent(in) :: st
+    type(particle_block_t), intent(inout) :: b
+    integer :: p, r, idx(3), top(3)
+
+    top = st%g%n - st%nsup
+    if (st%nd == 2) top(3) = 0
+    do p = 1, b%count
+       r = b%corner(p) - 1
+       idx(1) = mod(r, st%dom%n(1))
+       r = r / st%dom%n(1)
+       idx(2) = mod(r, st%dom%n(2))
+       idx(3) = r / st%dom%n(2)
+       idx = idx - st%g%offset
+       if (any(idx < 0) .or. any(idx > top)) call raise_error('mpm_halo', 0, 'particle outside the held ' // &
+            'box of its rank; expected the particles of a rank in its box (migration)')
+       b%corner(p) = 1 + idx(1) + st%g%n(1) * (idx(2) + st%g%n(2) * idx(3))
+    end do
+  end subroutine local_corners
 end module mpm_halo

@@ -15,6 +15,7 @@ module mpm_migrate
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow, block_keep
   use mpm_domain, only: domain_init, domain_build, rcb_boxes, cell_of, rank_of_cell
   use parallel_exchange, only: exchange_all
+  use mpm_halo, only: domain_regrid
   use parallel_comm, only: comm_sum, comm_max
   implicit none
   private
@@ -356,7 +357,8 @@ contains
   end function rebalance_check
 
   !> New boxes from the current particles (rcb_boxes on the global counts per cell), the plan
-  !> for them, and every particle to its new owner, re-packed into full blocks. Collective.
+  !> for them, the rank's grid on its new held box, and every particle to its new owner,
+  !> re-packed into full blocks. The walls' node lists are the caller's (mpm_setup). Collective.
   subroutine repartition(m, st)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
@@ -364,6 +366,7 @@ contains
 
     call global_cell_counts(st, counts)
     call domain_build(st%dom, rcb_boxes(counts, st%nranks))
+    call domain_regrid(st)
     call migrate_particles(m, st, .true.)
     st%dom%rebalances = st%dom%rebalances + 1
   end subroutine repartition
@@ -371,12 +374,15 @@ contains
   !> The end of an increment of a decomposed run: particles that left the box go to their new
   !> owner; every dom%rebalance_every increments the counts are compared and, above the
   !> threshold, the grid is partitioned again (increment boundaries only). Collective.
-  subroutine domain_increment_end(m, st)
+  subroutine domain_increment_end(m, st, regridded)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
+    logical, intent(out) :: regridded   !< re-partitioned: the grid is a new box
 
+    regridded = .false.
     call migrate_particles(m, st, .false.)
     if (mod(st%increment, st%dom%rebalance_every) /= 0) return
-    if (rebalance_check(st)) call repartition(m, st)
+    regridded = rebalance_check(st)
+    if (regridded) call repartition(m, st)
   end subroutine domain_increment_end
 end module mpm_migrate

@@ -55,7 +55,10 @@ contains
     if (axis == 0) return
     q = (w%p0(axis) - g%lo(axis)) / g%h
     layer = nint(q)
-    if (abs(q - layer) > node_on_wall_tolerance .or. layer < 0 .or. layer > g%n(axis) - 1) return
+    if (abs(q - layer) > node_on_wall_tolerance) return
+    ! the plane's layer in this grid's numbering (a rank's held box: mpm_grid's offset)
+    layer = layer - g%offset(axis)
+    if (layer < 0 .or. layer > g%n(axis) - 1) return
     tol = node_on_wall_tolerance * g%h
     allocate (plane(g%nn), front(g%nn), back(g%nn))
     np = 0

@@ -21,7 +21,7 @@ module mpm_musl
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
   use output_timer, only: timer_start, timer_stop
   use parallel_comm, only: comm_sum
-  use mpm_halo, only: halo_sum_p2g, halo_sum_momentum, owned_mass, sum_increment_accounts
+  use mpm_halo, only: halo_sum_p2g, halo_sum_momentum, owned_mass, sum_increment_accounts, local_corners
   implicit none
   private
 
@@ -287,8 +287,15 @@ contains
     character(len=160) :: text
     character(len=36) :: position
 
-    call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%corner, &
-         b%w1, b%dw1, outside)
+    if (st%dom%on) then
+       ! a decomposed grid: the stencil on the whole grid, then its corners on the rank's box
+       call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%dom%n, b%half, b%x, b%corner, &
+            b%w1, b%dw1, outside)
+       if (outside == 0) call local_corners(st, b)
+    else
+       call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%corner, &
+            b%w1, b%dw1, outside)
+    end if
     if (outside /= 0) then
        ! the position apart: a 2D particle has two coordinates, fewer than the edit descriptors
        write (position, '(3es12.4)') b%x(outside, :)

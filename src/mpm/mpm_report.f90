@@ -157,7 +157,7 @@ contains
     end do
     write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
     write (output_unit, '(a,i0,a,i0,a,i0,a,es10.3,a,a,a,i0,a)') '  mpm       ', st%nd, 'D, ', &
-         st%n_initial, ' particles, ', st%g%nn, ' grid nodes, cell ', m%mpm%cell, &
+         st%n_initial, ' particles, ', merge(product(st%dom%n), st%g%nn, st%dom%on), ' grid nodes, cell ', m%mpm%cell, &
          ', shape ', trim(merge('uGIMP ', 'linear', st%nsup == 3)), ', ', st%nranks, ' rank(s)'
     write (output_unit, '(a)') '  effects   ' // list
     write (output_unit, '(a)') '  output    ' // base // '.h5/.xmf (particles), ' // base // '_grid.xmf, ' // &
@@ -171,7 +171,7 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     real(dp) :: g(8), rate
-    integer :: ib, k, nmax(1)
+    integer :: ib, k, nmax(2)
     integer, allocatable :: moves(:)
 
     call measure(st)
@@ -183,9 +183,9 @@ contains
     g(3:8) = [st%mass_out, real(st%n_out, dp), st%w_external, real(st%n_guarded, dp), &
          real(st%particle_steps, dp), 0.0_dp]
     call sum_over_ranks(st, g)
-    nmax(1) = nint(g(8))
+    nmax = 0
     if (st%dom%on) then
-       nmax(1) = sum(st%blocks(1:st%nblocks)%count)
+       nmax = [sum(st%blocks(1:st%nblocks)%count), st%g%nn]
        call comm_max(st%comm, nmax)
     end if
     if (st%dom%on) then
@@ -196,9 +196,10 @@ contains
     if (st%rank /= 0) return
     if (st%dom%on) write (output_unit, '(a,*(i0,:,1x))') '  particles migrated from rank r to ranks 0..N-1 ' // &
          '(rank by rank): ', moves
-    if (st%dom%on) write (output_unit, '(a,i0,a,i0,a,i0,a,f6.3)') '  spatial decomposition: ', st%nranks, &
-         ' ranks, ', st%dom%rebalances, ' re-partitions; particles per rank now max ', nmax(1), ', max/mean ', &
-         nmax(1) * st%nranks / max(g(2), 1.0_dp)
+    if (st%dom%on) write (output_unit, '(a,i0,a,i0,a,i0,a,f6.3,a,i0,a,i0,a)') '  spatial decomposition: ', &
+         st%nranks, ' ranks, ', st%dom%rebalances, ' re-partitions; particles per rank now max ', nmax(1), &
+         ', max/mean ', nmax(1) * st%nranks / max(g(2), 1.0_dp), '; grid nodes held per rank now max ', nmax(2), &
+         ' of ', product(st%dom%n)
     write (output_unit, '(a,i0,a,i0,a,i0,a)') '  particles ', nint(g(2)), ' (', st%n_in, ' in, ', nint(g(4)), ' out)'
     write (output_unit, '(a,4es14.6,a,es10.2)') '  mass      initial, in, out, now:', st%mass_initial, st%mass_in, &
          g(3), g(1), '  balance error', st%mass_initial + st%mass_in - g(3) - g(1)

@@ -28,6 +28,8 @@ module mpm_run
   use mpm_flow, only: guard_particles, outflow, inflow
   use mpm_migrate, only: domain_increment_end
   use mpm_domain, only: domain_build
+  use mpm_halo, only: domain_regrid, whole_grid_shape
+  use mpm_setup, only: setup_walls, mark_wall_nodes
   use mpm_output, only: mpm_writer_t, mpm_writer_frame_count, mpm_field_request_t
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
   use output_timer, only: timer_start, timer_stop
@@ -47,6 +49,7 @@ contains
     type(mpm_state_t), intent(inout) :: st
     type(mpm_effects_t), intent(inout) :: fx
     integer :: ib, s
+    logical :: regridded
 
     s = st%step
     call step_gravity(m, st)
@@ -72,7 +75,13 @@ contains
        end if
     end if
     ! spatial decomposition: particles to the rank of their new position, re-partition if due
-    if (st%dom%on) call domain_increment_end(m, st)
+    if (st%dom%on) then
+       call domain_increment_end(m, st, regridded)
+       if (regridded) then
+          call setup_walls(m, st)
+          call mark_wall_nodes(m, st)
+       end if
+    end if
   end subroutine mpm_increment
 
   ! ------------------------------------------------------------------------------ checkpoint hooks
@@ -144,8 +153,14 @@ contains
     type(error_t) :: err
 
     call mpm_checkpoint_load(base, st%comm, m, st%nd, st%nc, st%nsup, st%blocks, st%nblocks, sv, err)
-    if (.not. err%raised) call mpm_restart_outputs(base, st%comm, st%g, st%nc, fields, columns, sv%frames, &
-         sv%rows, wr, hist, err)
+    if (.not. err%raised) then
+       if (st%dom%on) then
+          call mpm_restart_outputs(base, st%comm, whole_grid_shape(st), st%nc, fields, columns, sv%frames, &
+               sv%rows, wr, hist, err)
+       else
+          call mpm_restart_outputs(base, st%comm, st%g, st%nc, fields, columns, sv%frames, sv%rows, wr, hist, err)
+       end if
+    end if
     if (err%raised) call stop_agreed_error(st%comm, err)
     st%step = sv%step
     st%increment = sv%increment
@@ -182,6 +197,9 @@ contains
     if (st%dom%on) then
        st%dom%rebalances = sv%domain(1)
        call domain_build(st%dom, reshape(sv%domain(2:), [2, 3, st%nranks]))
+       call domain_regrid(st)
+       call setup_walls(m, st)
+       call mark_wall_nodes(m, st)
     end if
   end subroutine mpm_resume
 end module mpm_run
