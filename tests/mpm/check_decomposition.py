@@ -69,10 +69,12 @@ def compare(ref, other, tol, what):
     worst, where = 0.0, ""
     for k in a.dtype.names:
         scale = np.abs(a[k]).max()
+        # a vector component at round-off level (the tangential force of a symmetry plane, the
+        # centre of mass on a symmetry axis, the sideways velocity of a block) against the vector
         if k.startswith("WALLF"):
-            # a wall force component at round-off level (the tangential force of a symmetry
-            # plane) against the wall's force
             scale = max(np.abs(a[c]).max() for c in a.dtype.names if c.startswith("WALLF") and c[6:] == k[6:])
+        elif k[:3] in ("XCM", "VCM"):
+            scale = max(np.abs(a[c]).max() for c in a.dtype.names if c[:3] == k[:3])
         if scale == 0:
             continue
         d = np.abs(a[k] - b[k]).max() / scale
