@@ -12,7 +12,8 @@ module mpm_migrate
   use base_kinds, only: dp
   use model, only: model_t
   use mpm_state, only: mpm_state_t
-  use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow, block_keep
+  use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow, block_keep, &
+       drop_empty_blocks
   use mpm_domain, only: domain_init, domain_build, rcb_boxes, cell_of, rank_of_cell
   use parallel_exchange, only: exchange_all
   use mpm_halo, only: domain_regrid
@@ -189,7 +190,7 @@ contains
     logical, intent(in) :: compact
     integer, allocatable :: dest(:, :), keep(:), first(:), rfirst(:), slen(:)
     real(dp), allocatable :: sbuf(:), rbuf(:), kept(:)
-    integer :: ib, p, r, nr, nk, pos, len, j, me, nown, own_pos
+    integer :: ib, p, r, nr, nk, pos, len, me, nown, own_pos
 
     nr = st%nranks
     me = st%rank
@@ -246,13 +247,7 @@ contains
           end do
           if (nk < st%blocks(ib)%count) call block_keep(st%blocks(ib), keep(1:nk))
        end do
-       j = 0
-       do ib = 1, st%nblocks
-          if (st%blocks(ib)%count == 0) cycle
-          j = j + 1
-          if (j /= ib) st%blocks(j) = st%blocks(ib)
-       end do
-       st%nblocks = j
+       call drop_empty_blocks(st%blocks, st%nblocks)
     end if
     call unpack_records(m, st, rbuf)
   end subroutine migrate_particles

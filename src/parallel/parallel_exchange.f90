@@ -63,7 +63,7 @@ contains
     integer, intent(out) :: recv_first(0:nranks)
     real(dp), allocatable, intent(out) :: recv_buf(:)
     integer :: scount(0:nranks - 1), rcount(0:nranks - 1), sdispl(0:nranks - 1), rdispl(0:nranks - 1), r
-    real(dp) :: dummy(1)
+    real(dp), allocatable :: sb(:), rb(:)
 
     do r = 0, nranks - 1
        scount(r) = send_first(r + 1) - send_first(r)
@@ -75,20 +75,10 @@ contains
        rdispl(r) = recv_first(r) - 1
        recv_first(r + 1) = recv_first(r) + rcount(r)
     end do
-    allocate (recv_buf(recv_first(nranks) - 1))
-    ! zero-length buffers still need an address on both sides
-    if (size(send_buf) == 0 .and. size(recv_buf) == 0) then
-       call MPI_Alltoallv(dummy, scount, sdispl, MPI_DOUBLE_PRECISION, dummy, rcount, rdispl, &
-            MPI_DOUBLE_PRECISION, comm)
-    else if (size(send_buf) == 0) then
-       call MPI_Alltoallv(dummy, scount, sdispl, MPI_DOUBLE_PRECISION, recv_buf, rcount, rdispl, &
-            MPI_DOUBLE_PRECISION, comm)
-    else if (size(recv_buf) == 0) then
-       call MPI_Alltoallv(send_buf, scount, sdispl, MPI_DOUBLE_PRECISION, dummy, rcount, rdispl, &
-            MPI_DOUBLE_PRECISION, comm)
-    else
-       call MPI_Alltoallv(send_buf, scount, sdispl, MPI_DOUBLE_PRECISION, recv_buf, rcount, rdispl, &
-            MPI_DOUBLE_PRECISION, comm)
-    end if
+    ! buffers of at least one value: an empty one still needs an address on both sides
+    allocate (sb(max(1, size(send_buf))), rb(max(1, recv_first(nranks) - 1)))
+    sb(1:size(send_buf)) = send_buf
+    call MPI_Alltoallv(sb, scount, sdispl, MPI_DOUBLE_PRECISION, rb, rcount, rdispl, MPI_DOUBLE_PRECISION, comm)
+    allocate (recv_buf(recv_first(nranks) - 1), source=rb(1:recv_first(nranks) - 1))
   end subroutine exchange_all
 end module parallel_exchange

@@ -132,14 +132,20 @@ def repartitions(out):
     return int(m.group(2))
 
 
-def agree(args):
+def fresh_reference(args, extra=()):
+    """An emptied work directory and the scene's 1-rank (replicated) run in it."""
     wd = args.workdir
     if wd.exists():
         shutil.rmtree(wd)
     wd.mkdir(parents=True)
-    extra = ["--stop-after", str(args.stop_after)] if args.stop_after else []
     ref = wd / "np1"
     run(args, args.scene, ref, 1, extra)
+    return wd, ref
+
+
+def agree(args):
+    extra = ["--stop-after", str(args.stop_after)] if args.stop_after else []
+    wd, ref = fresh_reference(args, extra)
     deck = spatial_deck(args.scene, wd)
     for n in args.ranks:
         base = wd / f"spatial_np{n}"
@@ -167,12 +173,7 @@ def discharge(args):
     """The whole scene (fill and discharge with outflow and inflow) on --ranks: two runs on the
     last rank count identical; mass balance exact; the discharged mass within --mass-tol of one
     rank's (the flow through the outlet amplifies round-off: figures printed)."""
-    wd = args.workdir
-    if wd.exists():
-        shutil.rmtree(wd)
-    wd.mkdir(parents=True)
-    ref = wd / "np1"
-    run(args, args.scene, ref, 1)
+    wd, ref = fresh_reference(args)
     a = history(ref)
     deck = spatial_deck(args.scene, wd)
     for n in args.ranks:
@@ -199,12 +200,7 @@ def discharge(args):
 
 
 def rebalance(args):
-    wd = args.workdir
-    if wd.exists():
-        shutil.rmtree(wd)
-    wd.mkdir(parents=True)
-    ref = wd / "np1"
-    run(args, args.scene, ref, 1)
+    wd, ref = fresh_reference(args)
     deck = spatial_deck(args.scene, wd, f", REBALANCE={args.rebalance}")
     for n in args.ranks:
         base = wd / f"spatial_np{n}"
