@@ -3,6 +3,7 @@
 !>   *MPM GRID, CELL=h [, SHAPE=GIMP|LINEAR]        data: lo corner; hi corner (2 or 3 values)
 !>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a] [, SORT=n]   model data or in a step; carries over
 !>   *MPM SIDE FRICTION, GAP=t, FRICTION=μw         2D, model data or in a step; carries over
+!>     [, DECOMPOSITION=REPLICATED|SPATIAL] [, REBALANCE=r]   model data only (MPI ranks)
 !>   *PARTICLES, MATERIAL=name [, PPC=n] [, TYPE=BOX|POLYGON] [, Z1=, Z2=] [, VX=, VY=, VZ=]
 !>                                                  data: BOX lo; hi  |  POLYGON x, y per line
 !>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, OP=DELETE]
@@ -30,6 +31,7 @@ module scene_mpm
   use scene_layout, only: scene_layout_t
   use scene_materials, only: find_material
   use scene_mpm_side, only: read_side_friction
+  use scene_mpm_decomposition, only: read_decomposition
   use scene_util, only: itoa, rtoa, get_real, expect_lines, expect_fields, last_field, where_text, &
        check_name
   implicit none
@@ -137,6 +139,7 @@ contains
            select case (blk%name)
            case ('MPM CONTROLS')
               call read_controls(blk, carry, err)
+              if (.not. err%raised) call read_decomposition(blk, mpm, err)
            case ('MPM SIDE FRICTION')
               call read_side_friction(blk, mpm%ndim, carry, err)
            case ('PARTICLES')
@@ -166,6 +169,8 @@ contains
               select case (blk%name)
               case ('MPM CONTROLS')
                  call read_controls(blk, carry, err)
+                 if (.not. err%raised .and. (blk%has_param('DECOMPOSITION') .or. blk%has_param('REBALANCE'))) &
+                      call blk%fail('DECOMPOSITION/REBALANCE in a step; expected them in the model data', err)
               case ('MPM SIDE FRICTION')
                  call read_side_friction(blk, mpm%ndim, carry, err)
               case ('MPM WALL')
@@ -304,7 +309,7 @@ contains
     real(dp) :: flip, cfl, damping
     integer :: sort
 
-    call blk%check_params([character(len=8) :: 'FLIP', 'CFL', 'DAMPING', 'SORT'], err)
+    call blk%check_params([character(len=13) :: 'FLIP', 'CFL', 'DAMPING', 'SORT', 'DECOMPOSITION', 'REBALANCE'], err)
     if (.not. err%raised) call blk%get_real('FLIP', flip, err, default=c%flip, minimum=0.0_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('CFL', cfl, err, default=c%cfl, minimum=1.0e-3_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('DAMPING', damping, err, default=c%damping, minimum=0.0_dp, &

@@ -9,6 +9,7 @@ module mpm_scene
 
   integer, parameter, public :: shape_linear = 1      !< standard MPM hat functions
   integer, parameter, public :: shape_gimp = 2        !< uGIMP (particle domain kept, not stretched)
+  integer, parameter, public :: decomposition_replicated = 1, decomposition_spatial = 2
 
   integer, parameter, public :: region_box = 1
   integer, parameter, public :: region_polygon = 2    !< 2D polygon; in 3D extruded over z1..z2
@@ -85,5 +86,8 @@ module mpm_scene
      logical :: outflow = .false.
      real(dp) :: outflow_level = 0          !< particles below this (vertical axis) leave
      type(mpm_step_t), allocatable :: steps(:)
+     !> grid over MPI ranks: replicated (every rank the whole grid) or spatial (mpm_domain)
+     integer :: decomposition = decomposition_replicated
+     real(dp) :: rebalance = 0.25_dp         !< spatial: re-partition when max/mean − 1 of counts exceeds it
   end type mpm_scene_t
 end module mpm_scene

@@ -26,7 +26,8 @@
 !> do not match) is agreed between the ranks and ends the run cleanly: rank 0 prints
 !> `bulkflow: error: file: what is wrong; expected ...`, exit status 2, no MPI_Abort.
 module mpm_checkpoint
-  use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Bcast, MPI_INTEGER
+  use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Bcast, MPI_INTEGER
+  use mpm_scene, only: decomposition_spatial
   use base_kinds, only: dp
   use error_report, only: error_t, raise_error, add_expectation
   use model, only: model_t
@@ -64,6 +65,8 @@ module mpm_checkpoint
      real(dp) :: last_row_time = 0, last_row_out = 0  !< time and MASS_OUT of the last row (MDR)
      integer :: frames = 0                            !< field frames written (rank 0's writer)
      integer :: rows = 0                              !< history rows written
+     !> a spatially decomposed run (mpm_domain): re-partitions done, then the boxes (2, 3, nranks)
+     integer, allocatable :: domain(:)
   end type mpm_saved_t
 
   public :: mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
@@ -112,6 +115,7 @@ contains
     call checkpoint_put(ck, 'wall_force_row', sv%wall_force_row)
     ! only scenes with rigid surfaces (checkpoints of the others stay as they were)
     if (m%n_rigid_surfaces > 0) call checkpoint_put(ck, 'rigid_u', sv%rigid_u)
+    if (allocated(sv%domain)) call checkpoint_put(ck, 'domain', sv%domain)
     do ib = 1, nblocks
        info(:, ib) = [blocks(ib)%count, blocks(ib)%material, size(blocks(ib)%state, 2), size(blocks(ib)%field, 2)]
     end do
@@ -144,7 +148,7 @@ contains
     type(checkpoint_header_t) :: header
     real(dp), allocatable :: scalars(:), half(:), flat(:)
     integer, allocatable :: info(:, :), number(:)
-    integer :: counters(n_counters), ib, j, rank, nw, off
+    integer :: counters(n_counters), ib, j, rank, nw, off, nranks
     character(len=:), allocatable :: msg, file
     logical :: any_failed
 
@@ -181,6 +185,11 @@ contains
     allocate (sv%rigid_u(3, m%n_rigid_surfaces))
     sv%rigid_u = 0
     if (m%n_rigid_surfaces > 0) call checkpoint_get(ck, 'rigid_u', sv%rigid_u, err)
+    call MPI_Comm_size(comm, nranks)
+    if (m%mpm%decomposition == decomposition_spatial .and. nranks > 1) then
+       allocate (sv%domain(1 + 6 * nranks), source=0)
+       call checkpoint_get(ck, 'domain', sv%domain, err)
+    end if
     if (err%raised) return
     call unpack_scalars(scalars, sv)
     sv%next_number = counters(1)

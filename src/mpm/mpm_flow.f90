@@ -7,7 +7,7 @@ module mpm_flow
   use model, only: model_t
   use mpm_scene, only: mpm_wall_t, mpm_inflow_t
   use mpm_state, only: mpm_state_t
-  use mpm_particles, only: particle_block_size, block_keep
+  use mpm_particles, only: particle_block_size, block_keep, drop_empty_blocks
   use mpm_walls, only: wall_contains, wall_distance, wall_rows_behind, wall_slide_velocity
   use mpm_setup, only: add_particles
   use parallel_comm, only: comm_max_owner, comm_any, comm_sum
@@ -60,7 +60,7 @@ contains
   subroutine outflow(st, level)
     type(mpm_state_t), intent(inout) :: st
     real(dp), intent(in) :: level
-    integer :: ib, p, nk, j
+    integer :: ib, p, nk
     integer, allocatable :: keep(:)
 
     do ib = 1, st%nblocks
@@ -82,13 +82,7 @@ contains
          deallocate (keep)
        end associate
     end do
-    j = 0
-    do ib = 1, st%nblocks
-       if (st%blocks(ib)%count == 0) cycle
-       j = j + 1
-       if (j /= ib) st%blocks(j) = st%blocks(ib)
-    end do
-    st%nblocks = j
+    call drop_empty_blocks(st%blocks, st%nblocks)
   end subroutine outflow
 
   !> Keep the free surface at the inflow level: in each lattice column of the band, when the top

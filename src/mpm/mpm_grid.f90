@@ -11,6 +11,9 @@ module mpm_grid
      integer :: n(3) = 1                    !< nodes per direction
      integer :: nn = 0                      !< nodes in all
      real(dp) :: lo(3) = 0, h = 0
+     !> node (i, j, k) of this grid is node (i, j, k) + offset of the whole grid at lo: a rank's
+     !> held box of a spatially decomposed grid (mpm_domain); 0 for the whole grid
+     integer :: offset(3) = 0
      real(dp), allocatable :: mass(:)       !< (nn)
      !> (nn) the mass the particles of this model gave each node, before a mirror plane folded
      !> its image's in (mpm_mirror); weights wall forces and energies. = mass without mirrors.
@@ -24,7 +27,7 @@ module mpm_grid
      procedure :: position => grid_position
   end type grid_t
 
-  public :: grid_init, grid_reset, grid_reset_sums, grid_node_index, grid_clear
+  public :: grid_init, grid_init_box, grid_reset, grid_reset_sums, grid_node_index, grid_clear
   public :: grid_node_count, grid_sum_length
 
 contains
@@ -49,6 +52,24 @@ contains
          g%v_new(ndim, g%nn), g%active(g%nn))
     call grid_reset(g)
   end subroutine grid_init
+
+  !> The box of n(3) nodes from node `offset` of the whole grid at lo with cell h (positions are
+  !> the whole grid's: lo + (offset + (i, j, k)) h).
+  subroutine grid_init_box(g, ndim, lo, h, offset, n)
+    type(grid_t), intent(out) :: g
+    integer, intent(in) :: ndim, offset(3), n(3)
+    real(dp), intent(in) :: lo(3), h
+
+    g%ndim = ndim
+    g%h = h
+    g%lo = lo
+    g%offset = offset
+    g%n = n
+    g%nn = int(grid_node_count(g%n))
+    allocate (g%mass(g%nn), g%mass_own(g%nn), g%mom(ndim, g%nn), g%force(ndim, g%nn), g%v_old(ndim, g%nn), &
+         g%v_new(ndim, g%nn), g%active(g%nn))
+    call grid_reset(g)
+  end subroutine grid_init_box
 
   !> Nodes of a grid with n(k) nodes per direction, in 64 bits: a product of counts that a
   !> small cell takes beyond 2^31 (issue 16).
@@ -98,7 +119,7 @@ contains
     integer, intent(in) :: node
     real(dp) :: x(3)
 
-    x = g%lo + g%h * real(grid_node_index(g, node), dp)
+    x = g%lo + g%h * real(grid_node_index(g, node) + g%offset, dp)
     if (g%ndim == 2) x(3) = 0
   end function grid_position
 

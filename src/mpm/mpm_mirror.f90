@@ -57,7 +57,10 @@ contains
     if (axis == 0) return
     q = (w%p0(axis) - g%lo(axis)) / g%h
     layer = nint(q)
-    if (abs(q - layer) > node_on_wall_tolerance .or. layer < 0 .or. layer > g%n(axis) - 1) return
+    if (abs(q - layer) > node_on_wall_tolerance) return
+    ! the plane's layer in this grid's numbering (a rank's held box: mpm_grid's offset)
+    layer = layer - g%offset(axis)
+    if (layer < 0 .or. layer > g%n(axis) - 1) return
     tol = node_on_wall_tolerance * g%h
     allocate (plane(g%nn), front(g%nn), back(g%nn))
     np = 0
@@ -91,11 +94,14 @@ contains
 
   !> Fold mass, momentum and force of the P2G across the plane (the grid's mass before any fold
   !> is in g%mass_own, set by the caller). Returns the force the material exerts on the plane.
-  subroutine mirror_fold(mp, g, dt, reaction)
+  !> With `owned` (a spatially decomposed grid, mpm_domain) the reaction counts the plane nodes
+  !> and the pairs whose front node is owned here (the fold itself is done on every held pair).
+  subroutine mirror_fold(mp, g, dt, reaction, owned)
     type(mirror_plane_t), intent(in) :: mp
     type(grid_t), intent(inout) :: g
     real(dp), intent(in) :: dt
     real(dp), intent(out) :: reaction(3)
+    logical, intent(in), optional :: owned(:)
     integer :: k, f, b, a, nd
     real(dp) :: m, p(g%ndim), fo(g%ndim), v(g%ndim), exchange(g%ndim)
 
@@ -105,7 +111,7 @@ contains
     do k = 1, size(mp%plane)
        f = mp%plane(k)
        ! the image gives the same mass and tangential parts, the opposite normal parts
-       exchange(a) = exchange(a) - own_share(g, f) * (g%mom(a, f) + dt * g%force(a, f))
+       if (counted(f)) exchange(a) = exchange(a) - own_share(g, f) * (g%mom(a, f) + dt * g%force(a, f))
        g%mom(a, f) = 0
        g%force(a, f) = 0
     end do
@@ -117,7 +123,7 @@ contains
        p = g%mom(:, f) + reflect(g%mom(:, b), a)
        fo = g%force(:, f) + reflect(g%force(:, b), a)
        v = (p + dt * fo) / m
-       exchange = exchange + g%mass_own(f) * v - own_share(g, f) * (g%mom(:, f) + dt * g%force(:, f)) &
+       if (counted(f)) exchange = exchange + g%mass_own(f) * v - own_share(g, f) * (g%mom(:, f) + dt * g%force(:, f)) &
             + g%mass_own(b) * reflect(v, a) - own_share(g, b) * (g%mom(:, b) + dt * g%force(:, b))
        g%mass(f) = m
        g%mass(b) = m
@@ -128,6 +134,12 @@ contains
     end do
     reaction = 0
     reaction(1:nd) = -exchange / dt
+  contains
+    logical function counted(node)
+      integer, intent(in) :: node
+      counted = .true.
+      if (present(owned)) counted = owned(node)
+    end function counted
   end subroutine mirror_fold
 
   !> Fold the remapped momentum (MUSL) across the plane; masses were folded after the P2G.

@@ -23,6 +23,7 @@ module mpm_musl
   use output_effects, only: effects_t
   use mpm_side_friction, only: side_friction_grid, side_friction_work
   use parallel_comm, only: comm_sum
+  use mpm_halo, only: halo_sum_p2g, halo_sum_momentum, owned_mass, sum_increment_accounts, local_corners
   implicit none
   private
 
@@ -94,8 +95,11 @@ contains
     type(mpm_state_t), intent(inout) :: st
     type(effects_t), intent(inout) :: fx
     integer :: ib, k, s
+    real(dp) :: e_walls0, e_damping0
 
     s = st%step
+    e_walls0 = st%e_walls
+    e_damping0 = st%e_damping
     call fx%start(fx_p2g)
     call grid_reset_sums(st%g)
     ! *MPM CONTROLS, SORT=n: particles in cell order, transfers particle by particle (mpm_sort)
@@ -112,13 +116,22 @@ contains
           call p2g(st, st%blocks(ib))
        end if
     end do
-    if (st%nranks > 1) call reduce_grid(st, .true.)
+    if (st%dom%on) then
+       call halo_sum_p2g(st)
+    else if (st%nranks > 1) then
+       call reduce_grid(st, .true.)
+    end if
     st%g%mass_own = st%g%mass
     st%wall_force = 0
     do k = 1, size(m%mpm%walls)
-       if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) &
-            call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k))
+       if (.not. (st%mirrored(k) .and. m%mpm%walls(k)%active(s))) cycle
+       if (st%dom%on) then
+          call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k), st%dom%owned)
+       else
+          call mirror_fold(st%mirror(k), st%g, st%dt, st%wall_force(:, k))
+       end if
     end do
+    if (st%dom%on) call owned_mass(st)
     call fx%stop(fx_p2g)
 
     if (fx%active(fx_walls) .and. m%n_rigid_surfaces > 0) call surface_walls_at_new_time(m, st)
@@ -140,6 +153,7 @@ contains
             end if
           end associate
        end do
+       if (st%dom%on) call sum_increment_accounts(st, e_walls0, e_damping0)
        ! the work of the moving walls on the material, −F·v_w Δt (ALLWK; the grid and so the
        ! forces are the same on every rank: counted on rank 0)
        if (st%rank == 0) then
@@ -153,6 +167,8 @@ contains
        st%wall_impulse = st%wall_impulse + st%dt * st%wall_force
        st%impulse_time = st%impulse_time + st%dt
        call fx%stop(fx_walls)
+    else if (st%dom%on) then
+       call sum_increment_accounts(st, e_walls0, e_damping0)
     end if
     call side_friction_work(m, st, fx)    ! its work on the velocity the walls left
 
@@ -169,7 +185,11 @@ contains
           call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
        end if
     end do
-    if (st%nranks > 1) call reduce_grid(st, .false.)
+    if (st%dom%on) then
+       call halo_sum_momentum(st)
+    else if (st%nranks > 1) then
+       call reduce_grid(st, .false.)
+    end if
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
     end do
@@ -289,8 +309,15 @@ contains
     character(len=160) :: text
     character(len=36) :: position
 
-    call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%corner, &
-         b%w1, b%dw1, outside)
+    if (st%dom%on) then
+       ! a decomposed grid: the stencil on the whole grid, then its corners on the rank's box
+       call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%dom%n, b%half, b%x, b%corner, &
+            b%w1, b%dw1, outside)
+       if (outside == 0) call local_corners(st, b)
+    else
+       call block_stencil(b%count, st%nd, st%nsup, shape, st%g%lo, st%g%h, st%g%n, b%half, b%x, b%corner, &
+            b%w1, b%dw1, outside)
+    end if
     if (outside /= 0) then
        ! the position apart: a 2D particle has two coordinates, fewer than the edit descriptors
        write (position, '(3es12.4)') b%x(outside, :)

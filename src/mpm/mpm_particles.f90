@@ -33,7 +33,7 @@ module mpm_particles
      real(dp), allocatable :: w1(:, :, :), dw1(:, :, :)
   end type particle_block_t
 
-  public :: block_allocate, block_keep, block_grow
+  public :: block_allocate, block_keep, block_grow, drop_empty_blocks
 
 contains
 
@@ -124,6 +124,21 @@ contains
     g%log_strain(1:m, :) = b%log_strain
     b = g
   end subroutine block_grow
+
+  !> Blocks emptied by removals leave the list blocks(1:nblocks); the others keep their order.
+  subroutine drop_empty_blocks(blocks, nblocks)
+    type(particle_block_t), intent(inout) :: blocks(:)
+    integer, intent(inout) :: nblocks
+    integer :: ib, j
+
+    j = 0
+    do ib = 1, nblocks
+       if (blocks(ib)%count == 0) cycle
+       j = j + 1
+       if (j /= ib) blocks(j) = blocks(ib)
+    end do
+    nblocks = j
+  end subroutine drop_empty_blocks
 
   subroutine keep_r1(a, keep)
     real(dp), allocatable, intent(inout) :: a(:)

@@ -8,6 +8,9 @@ module mpm_report
   use mpm_state, only: mpm_state_t, sum_over_ranks, max_over_ranks
   use output_effects, only: effects_t
   use mpm_output, only: mpm_writer_t, mpm_writer_frame
+  use mpm_grid, only: grid_t
+  use mpm_halo, only: owned_grid
+  use parallel_comm, only: comm_max, comm_sum
   use output_history, only: history_t, history_row
   implicit none
   private
@@ -32,7 +35,15 @@ contains
     integer, intent(in) :: step
     real(dp), intent(in) :: step_time
 
-    call mpm_writer_frame(wr, m, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time)
+    type(grid_t) :: gw
+
+    if (st%dom%on) then
+       ! a decomposed grid: each node's mass and V from its owner (mpm_halo)
+       call owned_grid(st, gw)
+       call mpm_writer_frame(wr, m, st%blocks, st%nblocks, gw, step, st%increment, step_time, st%total_time)
+    else
+       call mpm_writer_frame(wr, m, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time)
+    end if
   end subroutine write_frame
 
   !> The history's columns: the fixed ones, then three force components per wall.
@@ -149,7 +160,7 @@ contains
 
     write (output_unit, '(a)') 'bulkflow: ' // trim(m%heading)
     write (output_unit, '(a,i0,a,i0,a,i0,a,es10.3,a,a,a,i0,a)') '  mpm       ', st%nd, 'D, ', &
-         st%n_initial, ' particles, ', st%g%nn, ' grid nodes, cell ', m%mpm%cell, &
+         st%n_initial, ' particles, ', merge(product(st%dom%n), st%g%nn, st%dom%on), ' grid nodes, cell ', m%mpm%cell, &
          ', shape ', trim(merge('uGIMP ', 'linear', st%nsup == 3)), ', ', st%nranks, ' rank(s)'
     write (output_unit, '(a)') fx%header_line()
     write (output_unit, '(a)') '  output    ' // base // '.h5/.xmf (particles), ' // base // '_grid.xmf, ' // &
@@ -163,7 +174,8 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     real(dp) :: g(8), rate
-    integer :: ib, k
+    integer :: ib, k, nmax(2)
+    integer, allocatable :: moves(:)
 
     call measure(st)
     g = 0
@@ -174,7 +186,23 @@ contains
     g(3:8) = [st%mass_out, real(st%n_out, dp), st%w_external, real(st%n_guarded, dp), &
          real(st%particle_steps, dp), 0.0_dp]
     call sum_over_ranks(st, g)
+    nmax = 0
+    if (st%dom%on) then
+       nmax = [sum(st%blocks(1:st%nblocks)%count), st%g%nn]
+       call comm_max(st%comm, nmax)
+    end if
+    if (st%dom%on) then
+       allocate (moves(st%nranks * st%nranks), source=0)
+       moves(st%rank * st%nranks + 1:(st%rank + 1) * st%nranks) = st%dom%sent
+       call comm_sum(st%comm, moves)
+    end if
     if (st%rank /= 0) return
+    if (st%dom%on) write (output_unit, '(a,*(i0,:,1x))') '  particles migrated from rank r to ranks 0..N-1 ' // &
+         '(rank by rank): ', moves
+    if (st%dom%on) write (output_unit, '(a,i0,a,i0,a,i0,a,f6.3,a,i0,a,i0,a)') '  spatial decomposition: ', &
+         st%nranks, ' ranks, ', st%dom%rebalances, ' re-partitions; particles per rank now max ', nmax(1), &
+         ', max/mean ', nmax(1) * st%nranks / max(g(2), 1.0_dp), '; grid nodes held per rank now max ', nmax(2), &
+         ' of ', product(st%dom%n)
     write (output_unit, '(a,i0,a,i0,a,i0,a)') '  particles ', nint(g(2)), ' (', st%n_in, ' in, ', nint(g(4)), ' out)'
     write (output_unit, '(a,4es14.6,a,es10.2)') '  mass      initial, in, out, now:', st%mass_initial, st%mass_in, &
          g(3), g(1), '  balance error', st%mass_initial + st%mass_in - g(3) - g(1)

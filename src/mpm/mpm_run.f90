@@ -15,6 +15,8 @@
 !> does the grid update and the walls itself; particles never migrate. Inflow particles are
 !> made by rank 0. Sums over ranks are in rank order: results are deterministic for a given
 !> number of ranks and differ from 1 rank by round-off only. Output: every rank writes its own blocks.
+!> With *MPM CONTROLS, DECOMPOSITION=SPATIAL the grid is decomposed instead (mpm_domain: boxes,
+!> halo sums in mpm_halo, particle migration and re-partition at the increment's end in mpm_migrate).
 !> Checkpoint and restart: src/mpm/mpm_checkpoint.f90.
 module mpm_run
   use base_kinds, only: dp
@@ -24,6 +26,10 @@ module mpm_run
   use mpm_musl, only: step_gravity, musl_transfer
   use mpm_stress_update, only: stress_update
   use mpm_flow, only: guard_particles, outflow, inflow
+  use mpm_migrate, only: domain_increment_end
+  use mpm_domain, only: domain_build
+  use mpm_halo, only: domain_regrid, whole_grid_shape
+  use mpm_setup, only: setup_walls, mark_wall_nodes
   use mpm_output, only: mpm_writer_t, mpm_writer_frame_count, mpm_field_request_t
   use mpm_checkpoint, only: mpm_saved_t, mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
   use output_effects, only: effects_t
@@ -43,6 +49,7 @@ contains
     type(mpm_state_t), intent(inout) :: st
     type(effects_t), intent(inout) :: fx
     integer :: ib, s
+    logical :: regridded
 
     s = st%step
     call step_gravity(m, st)
@@ -65,6 +72,14 @@ contains
           call fx%start(fx_inflow)
           call inflow(m, st, m%mpm%steps(s)%inflow)
           call fx%stop(fx_inflow)
+       end if
+    end if
+    ! spatial decomposition: particles to the rank of their new position, re-partition if due
+    if (st%dom%on) then
+       call domain_increment_end(m, st, regridded)
+       if (regridded) then
+          call setup_walls(m, st)
+          call mark_wall_nodes(m, st)
        end if
     end if
   end subroutine mpm_increment
@@ -116,6 +131,8 @@ contains
     sv%frames = 0
     if (st%rank == 0) sv%frames = mpm_writer_frame_count(wr)
     sv%rows = history_row_count(hist)
+    if (st%dom%on) allocate (sv%domain(1 + 6 * st%nranks), source=[st%dom%rebalances, &
+         reshape(st%dom%box, [6 * st%nranks])])
     call mpm_checkpoint_save(base, st%comm, m, st%blocks, st%nblocks, sv)
   end subroutine mpm_save
 
@@ -136,8 +153,14 @@ contains
     type(error_t) :: err
 
     call mpm_checkpoint_load(base, st%comm, m, st%nd, st%nc, st%nsup, st%blocks, st%nblocks, sv, err)
-    if (.not. err%raised) call mpm_restart_outputs(base, st%comm, st%g, st%nc, fields, columns, sv%frames, &
-         sv%rows, wr, hist, err)
+    if (.not. err%raised) then
+       if (st%dom%on) then
+          call mpm_restart_outputs(base, st%comm, whole_grid_shape(st), st%nc, fields, columns, sv%frames, &
+               sv%rows, wr, hist, err)
+       else
+          call mpm_restart_outputs(base, st%comm, st%g, st%nc, fields, columns, sv%frames, sv%rows, wr, hist, err)
+       end if
+    end if
     if (err%raised) call stop_agreed_error(st%comm, err)
     st%step = sv%step
     st%increment = sv%increment
@@ -170,5 +193,13 @@ contains
     st%step_increment = sv%step_increment
     last_row_time = sv%last_row_time
     last_row_out = sv%last_row_out
+    ! the boxes the checkpointed particles were in (a re-partition may have moved them)
+    if (st%dom%on) then
+       st%dom%rebalances = sv%domain(1)
+       call domain_build(st%dom, reshape(sv%domain(2:), [2, 3, st%nranks]))
+       call domain_regrid(st)
+       call setup_walls(m, st)
+       call mark_wall_nodes(m, st)
+    end if
   end subroutine mpm_resume
 end module mpm_run

@@ -8,7 +8,9 @@ module mpm_setup
   use error_report, only: raise_error
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
-  use mpm_scene, only: particle_region_t, region_box, region_polygon
+  use mpm_scene, only: particle_region_t, region_box, region_polygon, decomposition_spatial
+  use mpm_migrate, only: decompose_initial
+  use mpm_halo, only: domain_regrid
   use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
        fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_side_friction
   use output_effects, only: effects_t
@@ -23,7 +25,7 @@ module mpm_setup
   implicit none
   private
 
-  public :: mpm_setup_run, setup_state, generate_region, region_contains, add_particles, mark_wall_nodes
+  public :: mpm_setup_run, setup_state, setup_walls, generate_region, region_contains, add_particles, mark_wall_nodes
 
 contains
 
@@ -49,8 +51,9 @@ contains
       end do
       st%mass_cutoff = 1.0e-9_dp * maxval([(maxval(st%blocks(k)%mass), k = 1, st%nblocks)])
       st%n_initial = sum(st%blocks(1:st%nblocks)%count)
-      ! every rank made all blocks (same order); each keeps every nranks-th one
-      if (st%nranks > 1) then
+      ! every rank made all blocks (same order); each keeps every nranks-th one (the spatial
+      ! decomposition keeps the particles of its box instead, once the mirrors are known)
+      if (st%nranks > 1 .and. m%mpm%decomposition /= decomposition_spatial) then
          s = 0
          do k = 1, st%nblocks
             if (mod(k - 1, st%nranks) /= st%rank) cycle
@@ -68,22 +71,39 @@ contains
       allocate (st%rigid_u(3, m%n_rigid_surfaces), st%rigid_v(3, m%n_rigid_surfaces))
       st%rigid_u = 0
       st%rigid_v = 0
-      do k = 1, size(mpm%walls)
-         if (mpm%walls(k)%surface > 0) then
-            ! a rigid-surface wall finds its nodes every increment (it may move: mpm_musl)
-            allocate (st%wall_nodes(k)%nodes(0), st%wall_nodes(k)%normal(3, 0))
-            st%mirrored(k) = .false.
-            cycle
-         end if
-         call wall_find_nodes(mpm%walls(k), st%g, st%wall_nodes(k))
-         call mirror_plane_setup(mpm%walls(k), st%g, st%mirror(k), st%mirrored(k))
-         ! a mirrored plane is no wall to the grid: its nodes and images are damped as the full
-         ! model's would be (the fold leaves them symmetric)
-         if (st%mirrored(k)) st%wall_nodes(k)%nodes = [integer ::]
-      end do
+      call setup_walls(m, st)
+      if (st%nranks > 1 .and. m%mpm%decomposition == decomposition_spatial) then
+         ! the rank's box of the grid, its particles, and the walls on its held nodes
+         call decompose_initial(m, st, m%mpm%rebalance)
+         call domain_regrid(st)
+         call setup_walls(m, st)
+      end if
     end associate
     call setup_effects(m, fx)
   end subroutine mpm_setup_run
+
+  !> The walls' node lists and the mirrored symmetry planes on the rank's grid (again after a
+  !> spatial decomposition changed the grid: mpm_domain).
+  subroutine setup_walls(m, st)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    integer :: k
+
+    do k = 1, size(m%mpm%walls)
+       if (m%mpm%walls(k)%surface > 0) then
+          ! a rigid-surface wall finds its nodes every increment (it may move: mpm_musl)
+          if (allocated(st%wall_nodes(k)%nodes)) deallocate (st%wall_nodes(k)%nodes, st%wall_nodes(k)%normal)
+          allocate (st%wall_nodes(k)%nodes(0), st%wall_nodes(k)%normal(3, 0))
+          st%mirrored(k) = .false.
+          cycle
+       end if
+       call wall_find_nodes(m%mpm%walls(k), st%g, st%wall_nodes(k))
+       call mirror_plane_setup(m%mpm%walls(k), st%g, st%mirror(k), st%mirrored(k))
+       ! a mirrored plane is no wall to the grid: its nodes and images are damped as the full
+       ! model's would be (the fold leaves them symmetric)
+       if (st%mirrored(k)) st%wall_nodes(k)%nodes = [integer ::]
+    end do
+  end subroutine setup_walls
 
   !> Sizes (dimension, stress components, stencil), the grid, the materials' moduli and the
   !> full-block VUMAT work set; no particles yet.
@@ -281,6 +301,10 @@ contains
     type(mpm_state_t), intent(inout) :: st
     integer :: k
 
+    if (allocated(st%on_wall)) then
+       ! a re-partitioned grid (mpm_domain) has another number of nodes
+       if (size(st%on_wall) /= st%g%nn) deallocate (st%on_wall)
+    end if
     if (.not. allocated(st%on_wall)) allocate (st%on_wall(st%g%nn))
     st%on_wall = .false.
     do k = 1, size(m%mpm%walls)

@@ -13,6 +13,7 @@ module mpm_state
   use mpm_particles, only: particle_block_t
   use mpm_walls, only: wall_nodes_t
   use mpm_mirror, only: mirror_plane_t
+  use mpm_domain, only: domain_t
   use material_door, only: vumat_work_t
   use output_effects, only: first_technique_effect
   use parallel_comm, only: comm_sum, comm_max
@@ -39,6 +40,8 @@ module mpm_state
      !> per wall: a symmetry plane on a node plane is done by mirroring the grid (mpm_mirror)
      type(mirror_plane_t), allocatable :: mirror(:)
      logical, allocatable :: mirrored(:)
+     !> the spatial decomposition of the grid (mpm_domain; %on false: the replicated grid)
+     type(domain_t) :: dom
      real(dp), allocatable :: modulus(:)             !< per material: λ + 2G (packaging call)
      logical, allocatable :: needs_kinematics(:)     !< per material: user VUMAT reads F, U
      !> VUMAT work sets: work(1) has particle_block_size rows (full blocks), work(2) the rows of

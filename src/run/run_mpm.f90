@@ -6,6 +6,7 @@ module run_mpm
   use model, only: model_t
   use mpm_state, only: mpm_state_t
   use mpm_setup, only: mpm_setup_run, mark_wall_nodes
+  use mpm_halo, only: whole_grid_shape
   use mpm_musl, only: stable_increment_of => stable_increment
   use mpm_report, only: report_header => header, report_summary => summary, history_columns, measure, &
        write_history, write_frame
@@ -48,7 +49,12 @@ contains
     type(model_t), intent(in) :: m
     type(run_options_t), intent(in) :: opts
 
-    call mpm_writer_open(this%wr, opts%output_base, this%comm, this%st%g, this%st%nc, this%fields)
+    if (this%st%dom%on) then
+       ! a decomposed grid: the frames show the whole grid (mpm_halo)
+       call mpm_writer_open(this%wr, opts%output_base, this%comm, whole_grid_shape(this%st), this%st%nc, this%fields)
+    else
+       call mpm_writer_open(this%wr, opts%output_base, this%comm, this%st%g, this%st%nc, this%fields)
+    end if
     call history_open(this%hist, opts%output_base // '_history.csv', this%columns, this%comm)
     this%last_row_time = 0
     this%last_row_out = 0

@@ -1,0 +1,383 @@
+!> Particles between the ranks of a spatially decomposed MPM run (mpm_domain): the first split
+!> of the set-up's particles, the migration of the particles whose position left the rank's box
+!> (end of every increment), and the re-partition when the particle counts drift apart.
+!>
+!> A particle travels as one row of reals: material, half-length, number, x, v, mass, V0, F, R,
+!> σ (corotational and global), specific energies, LE, state and field variables (the widths of
+!> its material's blocks) — everything a block holds across increments (the stencil is made again
+!> at the next P2G). Received rows are appended in the order they come (source rank, then the
+!> sender's block order) to blocks of their material and spacing (≤ particle_block_size each),
+!> so a run is deterministic for a given rank count.
+module mpm_migrate
+  use base_kinds, only: dp
+  use model, only: model_t
+  use mpm_state, only: mpm_state_t
+  use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow, block_keep, &
+       drop_empty_blocks
+  use mpm_domain, only: domain_init, domain_build, rcb_boxes, cell_of, rank_of_cell
+  use parallel_exchange, only: exchange_all
+  use mpm_halo, only: domain_regrid
+  use parallel_comm, only: comm_sum, comm_max
+  implicit none
+  private
+
+  public :: decompose_initial, migrate_particles, rebalance_check, repartition, record_length, &
+       pack_record, unpack_records, domain_increment_end
+
+contains
+
+  !> Reals of one particle's row for a material with nsv state and nfv field columns.
+  pure integer function record_length(nd, nc, nsv, nfv)
+    integer, intent(in) :: nd, nc, nsv, nfv
+    record_length = 3 + 2 * nd + 2 + 2 * nd * nd + 3 * nc + 2 + nsv + nfv
+  end function record_length
+
+  !> Row p of block b into buf(pos:), pos advanced past it.
+  subroutine pack_record(b, p, nd, buf, pos)
+    type(particle_block_t), intent(in) :: b
+    integer, intent(in) :: p, nd
+    real(dp), intent(inout) :: buf(:)
+    integer, intent(inout) :: pos
+    integer :: nc
+
+    nc = size(b%stress, 2)
+    call put([real(b%material, dp), b%half, real(b%number(p), dp)])
+    call put(b%x(p, :))
+    call put(b%v(p, :))
+    call put([b%mass(p), b%vol0(p)])
+    call put(reshape(b%f(p, :, :), [nd * nd]))
+    call put(reshape(b%rot(p, :, :), [nd * nd]))
+    call put(b%stress(p, :))
+    call put(b%stress_global(p, :))
+    call put([b%e_int(p), b%e_inel(p)])
+    call put(b%log_strain(p, :))
+    call put(b%state(p, :))
+    call put(b%field(p, :))
+  contains
+    subroutine put(v)
+      real(dp), intent(in) :: v(:)
+      buf(pos:pos + size(v) - 1) = v
+      pos = pos + size(v)
+    end subroutine put
+  end subroutine pack_record
+
+  !> Append the rows buf(1:n) (pack_record's) to the rank's blocks: a run of rows of one
+  !> material and spacing fills the last block of that kind, then new blocks.
+  subroutine unpack_records(m, st, buf)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    real(dp), intent(in) :: buf(:)
+    integer :: pos, mat, ib, first, nd, nc, nsv, nfv, len
+    real(dp) :: half
+
+    nd = st%nd
+    nc = st%nc
+    pos = 1
+    do while (pos <= size(buf))
+       mat = nint(buf(pos))
+       half = buf(pos + 1)
+       nsv = max(1, m%materials(mat)%nstatev)
+       nfv = max(1, m%materials(mat)%nfieldv)
+       len = record_length(nd, nc, nsv, nfv)
+       ib = 0
+       if (st%nblocks > 0) then
+          associate (b => st%blocks(st%nblocks))
+            if (b%material == mat .and. abs(b%half - half) <= 1.0e-12_dp * half .and. &
+                 b%count < particle_block_size) ib = st%nblocks
+          end associate
+       end if
+       if (ib == 0) then
+          call append_block(st)
+          ib = st%nblocks
+          call block_allocate(st%blocks(ib), 0, nd, nc, nsv, nfv, st%nsup)
+          st%blocks(ib)%material = mat
+          st%blocks(ib)%half = half
+       end if
+       associate (b => st%blocks(ib))
+         ! the rows of this kind that still fit, in one growth
+         first = b%count + 1
+         call block_grow(b, b%count + run_length(pos, len, particle_block_size - b%count), nd)
+         do while (first <= b%count)
+            call take(b, first)
+            first = first + 1
+         end do
+       end associate
+    end do
+  contains
+    !> Rows from pos on of the same material and half as the one at pos, at most room.
+    integer function run_length(start, rec, room) result(k)
+      integer, intent(in) :: start, rec, room
+      integer :: q
+      k = 0
+      q = start
+      do while (q <= size(buf) .and. k < room)
+         if (nint(buf(q)) /= mat .or. abs(buf(q + 1) - half) > 1.0e-12_dp * half) exit
+         k = k + 1
+         q = q + rec
+      end do
+    end function run_length
+
+    subroutine take(b, p)
+      type(particle_block_t), intent(inout) :: b
+      integer, intent(in) :: p
+      b%number(p) = nint(buf(pos + 2))
+      pos = pos + 3
+      b%x(p, :) = get(nd)
+      b%v(p, :) = get(nd)
+      b%mass(p) = buf(pos)
+      b%vol0(p) = buf(pos + 1)
+      pos = pos + 2
+      b%f(p, :, :) = reshape(get(nd * nd), [nd, nd])
+      b%rot(p, :, :) = reshape(get(nd * nd), [nd, nd])
+      b%stress(p, :) = get(nc)
+      b%stress_global(p, :) = get(nc)
+      b%e_int(p) = buf(pos)
+      b%e_inel(p) = buf(pos + 1)
+      pos = pos + 2
+      b%log_strain(p, :) = get(nc)
+      b%state(p, :) = get(nsv)
+      b%field(p, :) = get(nfv)
+    end subroutine take
+
+    function get(k) result(v)
+      integer, intent(in) :: k
+      real(dp) :: v(k)
+      v = buf(pos:pos + k - 1)
+      pos = pos + k
+    end function get
+  end subroutine unpack_records
+
+  !> One more (empty) slot at the end of st%blocks.
+  subroutine append_block(st)
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), allocatable :: grown(:)
+    if (.not. allocated(st%blocks)) allocate (st%blocks(16))
+    if (st%nblocks == size(st%blocks)) then
+       allocate (grown(2 * max(1, st%nblocks)))
+       grown(1:st%nblocks) = st%blocks(1:st%nblocks)
+       call move_alloc(grown, st%blocks)
+    end if
+    st%nblocks = st%nblocks + 1
+  end subroutine append_block
+
+  !> The destination rank of every particle of the rank (dest(p, ib)), from its cell.
+  subroutine destinations(st, dest)
+    type(mpm_state_t), intent(in) :: st
+    integer, intent(out) :: dest(:, :)          !< (particle_block_size, nblocks)
+    integer :: ib, p, c(3), r
+
+    r = st%dom%rank
+    do ib = 1, st%nblocks
+       associate (b => st%blocks(ib))
+         do p = 1, b%count
+            c = cell_of(st%dom, st%g%lo, st%g%h, b%x(p, :))
+            if (all(c(1:st%nd) >= st%dom%box(1, 1:st%nd, r)) .and. all(c(1:st%nd) <= st%dom%box(2, 1:st%nd, r))) then
+               dest(p, ib) = r
+            else
+               dest(p, ib) = rank_of_cell(st%dom, c)
+            end if
+         end do
+       end associate
+    end do
+  end subroutine destinations
+
+  !> Send every particle whose cell is in another rank's box to that rank; keep the others (blocks
+  !> keep their order, emptied blocks leave). With compact, the kept particles are re-packed into
+  !> full blocks too (after a re-partition). Collective.
+  subroutine migrate_particles(m, st, compact)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    logical, intent(in) :: compact
+    integer, allocatable :: dest(:, :), keep(:), first(:), rfirst(:), slen(:)
+    real(dp), allocatable :: sbuf(:), rbuf(:), kept(:)
+    integer :: ib, p, r, nr, nk, pos, len, me, nown, own_pos
+
+    nr = st%nranks
+    me = st%rank
+    allocate (dest(particle_block_size, max(1, st%nblocks)), first(0:nr), rfirst(0:nr), slen(0:nr - 1))
+    call destinations(st, dest)
+    ! sizes per destination rank (this rank's own rows apart: kept, or re-packed with compact)
+    slen = 0
+    nown = 0
+    own_pos = 1
+    do ib = 1, st%nblocks
+       len = record_length(st%nd, st%nc, size(st%blocks(ib)%state, 2), size(st%blocks(ib)%field, 2))
+       do p = 1, st%blocks(ib)%count
+          r = dest(p, ib)
+          if (r /= me) then
+             slen(r) = slen(r) + len
+             if (.not. compact) st%dom%sent(r) = st%dom%sent(r) + 1
+          else if (compact) then
+             nown = nown + len
+          end if
+       end do
+    end do
+    first(0) = 1
+    do r = 0, nr - 1
+       first(r + 1) = first(r) + slen(r)
+    end do
+    allocate (sbuf(first(nr) - 1), kept(nown))
+    ! rows in rank order, block order within a rank
+    do r = 0, nr - 1
+       if (r == me .and. .not. compact) cycle
+       pos = first(r)
+       do ib = 1, st%nblocks
+          do p = 1, st%blocks(ib)%count
+             if (dest(p, ib) /= r) cycle
+             if (r == me) then
+                call pack_record(st%blocks(ib), p, st%nd, kept, own_pos)
+             else
+                call pack_record(st%blocks(ib), p, st%nd, sbuf, pos)
+             end if
+          end do
+       end do
+    end do
+    call exchange_all(st%comm, nr, first, sbuf, rfirst, rbuf)
+    if (compact) then
+       st%nblocks = 0
+       call unpack_records(m, st, kept)
+    else
+       allocate (keep(particle_block_size))
+       do ib = 1, st%nblocks
+          nk = 0
+          do p = 1, st%blocks(ib)%count
+             if (dest(p, ib) /= me) cycle
+             nk = nk + 1
+             keep(nk) = p
+          end do
+          if (nk < st%blocks(ib)%count) call block_keep(st%blocks(ib), keep(1:nk))
+       end do
+       call drop_empty_blocks(st%blocks, st%nblocks)
+    end if
+    call unpack_records(m, st, rbuf)
+  end subroutine migrate_particles
+
+  !> Particles per cell over all ranks (cells of the grid, (c1, c2, c3)). Collective.
+  subroutine global_cell_counts(st, counts)
+    type(mpm_state_t), intent(in) :: st
+    integer, allocatable, intent(out) :: counts(:, :, :)
+    integer :: ib, p, c(3)
+    integer, allocatable :: flat(:)
+
+    allocate (counts(st%dom%ncell(1), st%dom%ncell(2), st%dom%ncell(3)))
+    counts = 0
+    do ib = 1, st%nblocks
+       associate (b => st%blocks(ib))
+         do p = 1, b%count
+            c = cell_of(st%dom, st%g%lo, st%g%h, b%x(p, :))
+            counts(c(1) + 1, c(2) + 1, c(3) + 1) = counts(c(1) + 1, c(2) + 1, c(3) + 1) + 1
+         end do
+       end associate
+    end do
+    allocate (flat(size(counts)), source=reshape(counts, [size(counts)]))
+    call comm_sum(st%comm, flat)
+    counts = reshape(flat, shape(counts))
+  end subroutine global_cell_counts
+
+  !> The first decomposition: every rank made all particles (same order); the boxes come from
+  !> their counts per cell and each rank keeps those in its box, re-packed into full blocks.
+  !> No communication (every rank sees every particle).
+  subroutine decompose_initial(m, st, rebalance)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    real(dp), intent(in) :: rebalance
+    integer, allocatable :: counts(:, :, :), axis(:), layer(:)
+    integer :: ib, p, c(3), k, nmir, pos, total
+    real(dp), allocatable :: buf(:)
+
+    nmir = count(st%mirrored)
+    allocate (axis(nmir), layer(nmir))
+    nmir = 0
+    do k = 1, size(st%mirrored)
+       if (.not. st%mirrored(k)) cycle
+       nmir = nmir + 1
+       axis(nmir) = st%mirror(k)%axis
+       ! the plane's node layer along its axis (every plane node has it)
+       layer(nmir) = plane_layer(st, k)
+    end do
+    call domain_init(st%dom, st%rank, st%nranks, st%nd, st%g%n, st%nsup, axis, layer, rebalance)
+    allocate (counts(st%dom%ncell(1), st%dom%ncell(2), st%dom%ncell(3)))
+    counts = 0
+    do ib = 1, st%nblocks
+       do p = 1, st%blocks(ib)%count
+          c = cell_of(st%dom, st%g%lo, st%g%h, st%blocks(ib)%x(p, :))
+          counts(c(1) + 1, c(2) + 1, c(3) + 1) = counts(c(1) + 1, c(2) + 1, c(3) + 1) + 1
+       end do
+    end do
+    call domain_build(st%dom, rcb_boxes(counts, st%nranks))
+    total = 0
+    do ib = 1, st%nblocks
+       total = total + st%blocks(ib)%count * record_length(st%nd, st%nc, size(st%blocks(ib)%state, 2), &
+            size(st%blocks(ib)%field, 2))
+    end do
+    allocate (buf(total))
+    pos = 1
+    do ib = 1, st%nblocks
+       do p = 1, st%blocks(ib)%count
+          c = cell_of(st%dom, st%g%lo, st%g%h, st%blocks(ib)%x(p, :))
+          if (rank_of_cell(st%dom, c) == st%rank) call pack_record(st%blocks(ib), p, st%nd, buf, pos)
+       end do
+    end do
+    st%nblocks = 0
+    call unpack_records(m, st, buf(1:pos - 1))
+  end subroutine decompose_initial
+
+  !> The node layer of mirrored plane k along its axis.
+  integer function plane_layer(st, k) result(layer)
+    type(mpm_state_t), intent(in) :: st
+    integer, intent(in) :: k
+    integer :: r, a
+
+    a = st%mirror(k)%axis
+    layer = -1
+    if (size(st%mirror(k)%plane) == 0) return
+    r = st%mirror(k)%plane(1) - 1
+    if (a >= 2) r = r / st%g%n(1)
+    if (a == 3) r = r / st%g%n(2)
+    layer = mod(r, st%g%n(a))
+  end function plane_layer
+
+  !> Is the imbalance of the particle counts, max/mean − 1, above the threshold? Collective.
+  logical function rebalance_check(st) result(due)
+    type(mpm_state_t), intent(in) :: st
+    integer :: n(1), nmax(1)
+
+    n(1) = sum(st%blocks(1:st%nblocks)%count)
+    nmax = n
+    call comm_sum(st%comm, n)
+    call comm_max(st%comm, nmax)
+    due = .false.
+    if (n(1) == 0) return
+    due = real(nmax(1), dp) * st%nranks / n(1) - 1 > st%dom%rebalance
+  end function rebalance_check
+
+  !> New boxes from the current particles (rcb_boxes on the global counts per cell), the plan
+  !> for them, the rank's grid on its new held box, and every particle to its new owner,
+  !> re-packed into full blocks. The walls' node lists are the caller's (mpm_setup). Collective.
+  subroutine repartition(m, st)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    integer, allocatable :: counts(:, :, :)
+
+    call global_cell_counts(st, counts)
+    call domain_build(st%dom, rcb_boxes(counts, st%nranks))
+    call domain_regrid(st)
+    call migrate_particles(m, st, .true.)
+    st%dom%rebalances = st%dom%rebalances + 1
+  end subroutine repartition
+
+  !> The end of an increment of a decomposed run: particles that left the box go to their new
+  !> owner; every dom%rebalance_every increments the counts are compared and, above the
+  !> threshold, the grid is partitioned again (increment boundaries only). Collective.
+  subroutine domain_increment_end(m, st, regridded)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    logical, intent(out) :: regridded   !< re-partitioned: the grid is a new box
+
+    regridded = .false.
+    call migrate_particles(m, st, .false.)
+    if (mod(st%increment, st%dom%rebalance_every) /= 0) return
+    regridded = rebalance_check(st)
+    if (regridded) call repartition(m, st)
+  end subroutine domain_increment_end
+end module mpm_migrate
