@@ -12,9 +12,11 @@
 !>     field frames and history rows written so far;
 !>   * the scene's digest (model_digest: a hash per keyword and data line), so that a restart
 !>     of an edited scene is refused at the first line that differs (file:line).
-!> Everything else (grid, wall node lists, mirror planes, material moduli) is rebuilt by the
-!> set-up from the scene, and the grid carries no history (mpm_grid), so a restarted run
-!> repeats the uninterrupted one bit for bit.
+!>   * this rank's grid mass and velocity of the last increment: the grid carries no history
+!>     (mpm_grid: every increment starts from zero), but the frame written at the start of the
+!>     next step shows the last increment's grid, so a restart at a step's end needs it.
+!> Everything else (wall node lists, mirror planes, material moduli) is rebuilt by the set-up
+!> from the scene, so a restarted run repeats the uninterrupted one bit for bit.
 !>
 !> Files: one per rank, `<base>.rst.<rank>`, in the element driver's format (output_checkpoint:
 !> atomic replacement, rank count, names, kinds and shapes checked), so a restart needs the
@@ -67,6 +69,9 @@ module mpm_checkpoint
      integer :: rows = 0                              !< history rows written
      !> a spatially decomposed run (mpm_domain): re-partitions done, then the boxes (2, 3, nranks)
      integer, allocatable :: domain(:)
+     !> this rank's grid mass and velocity v_n+1 of the last increment: the frame at the start of
+     !> the next step shows them (a restart at a step's end writes that frame)
+     real(dp), allocatable :: grid_mass(:), grid_v(:, :)
   end type mpm_saved_t
 
   public :: mpm_checkpoint_save, mpm_checkpoint_load, mpm_restart_outputs
@@ -116,6 +121,9 @@ contains
     ! only scenes with rigid surfaces (checkpoints of the others stay as they were)
     if (m%n_rigid_surfaces > 0) call checkpoint_put(ck, 'rigid_u', sv%rigid_u)
     if (allocated(sv%domain)) call checkpoint_put(ck, 'domain', sv%domain)
+    call checkpoint_put(ck, 'grid_size', [size(sv%grid_mass)])
+    call checkpoint_put(ck, 'grid_mass', sv%grid_mass)
+    call checkpoint_put(ck, 'grid_v', sv%grid_v)
     do ib = 1, nblocks
        info(:, ib) = [blocks(ib)%count, blocks(ib)%material, size(blocks(ib)%state, 2), size(blocks(ib)%field, 2)]
     end do
@@ -148,7 +156,7 @@ contains
     type(checkpoint_header_t) :: header
     real(dp), allocatable :: scalars(:), half(:), flat(:)
     integer, allocatable :: info(:, :), number(:)
-    integer :: counters(n_counters), ib, j, rank, nw, off, nranks
+    integer :: counters(n_counters), ib, j, rank, nw, off, nranks, grid_size(1)
     character(len=:), allocatable :: msg, file
     logical :: any_failed
 
@@ -190,6 +198,12 @@ contains
        allocate (sv%domain(1 + 6 * nranks), source=0)
        call checkpoint_get(ck, 'domain', sv%domain, err)
     end if
+    grid_size = 0
+    call checkpoint_get(ck, 'grid_size', grid_size, err)
+    allocate (sv%grid_mass(max(grid_size(1), 0)), source=0.0_dp)
+    allocate (sv%grid_v(nd, max(grid_size(1), 0)), source=0.0_dp)
+    call checkpoint_get(ck, 'grid_mass', sv%grid_mass, err)
+    call checkpoint_get(ck, 'grid_v', sv%grid_v, err)
     if (err%raised) return
     call unpack_scalars(scalars, sv)
     sv%next_number = counters(1)

@@ -133,6 +133,8 @@ contains
     sv%rows = history_row_count(hist)
     if (st%dom%on) allocate (sv%domain(1 + 6 * st%nranks), source=[st%dom%rebalances, &
          reshape(st%dom%box, [6 * st%nranks])])
+    allocate (sv%grid_mass(size(st%g%mass)), source=st%g%mass)
+    allocate (sv%grid_v(size(st%g%v_new, 1), size(st%g%v_new, 2)), source=st%g%v_new)
     call mpm_checkpoint_save(base, st%comm, m, st%blocks, st%nblocks, sv)
   end subroutine mpm_save
 
@@ -200,6 +202,11 @@ contains
        call domain_regrid(st)
        call setup_walls(m, st)
        call mark_wall_nodes(m, st)
+    end if
+    ! the last increment's grid, which a frame at the next step's start shows
+    if (size(sv%grid_mass) == size(st%g%mass) .and. size(sv%grid_v) == size(st%g%v_new)) then
+       st%g%mass = sv%grid_mass
+       st%g%v_new = sv%grid_v
     end if
   end subroutine mpm_resume
 end module mpm_run
