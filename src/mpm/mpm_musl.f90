@@ -11,7 +11,7 @@ module mpm_musl
   use model, only: model_t
   use model_time_variation, only: variation_factor
   use model_steps, only: bc_velocity
-  use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_walls, max_over_ranks, det_f
+  use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_walls, fx_exchange, max_over_ranks, det_f
   use mpm_grid, only: grid_sum_length, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t
   use mpm_shape, only: block_stencil
@@ -116,10 +116,16 @@ contains
           call p2g(st, st%blocks(ib))
        end if
     end do
-    if (st%dom%on) then
-       call halo_sum_p2g(st)
-    else if (st%nranks > 1) then
-       call reduce_grid(st, .true.)
+    if (st%nranks > 1) then
+       call fx%stop(fx_p2g)
+       call fx%start(fx_exchange)
+       if (st%dom%on) then
+          call halo_sum_p2g(st)
+       else
+          call reduce_grid(st, .true.)
+       end if
+       call fx%stop(fx_exchange)
+       call fx%start(fx_p2g)
     end if
     st%g%mass_own = st%g%mass
     st%wall_force = 0
@@ -185,10 +191,16 @@ contains
           call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
        end if
     end do
-    if (st%dom%on) then
-       call halo_sum_momentum(st)
-    else if (st%nranks > 1) then
-       call reduce_grid(st, .false.)
+    if (st%nranks > 1) then
+       call fx%stop(fx_g2p)
+       call fx%start(fx_exchange)
+       if (st%dom%on) then
+          call halo_sum_momentum(st)
+       else
+          call reduce_grid(st, .false.)
+       end if
+       call fx%stop(fx_exchange)
+       call fx%start(fx_g2p)
     end if
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)

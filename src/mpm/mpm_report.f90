@@ -174,7 +174,7 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     real(dp) :: g(8), rate
-    integer :: ib, k, nmax(2)
+    integer :: ib, k, nmax(5)
     integer, allocatable :: moves(:)
 
     call measure(st)
@@ -188,7 +188,10 @@ contains
     call sum_over_ranks(st, g)
     nmax = 0
     if (st%dom%on) then
-       nmax = [sum(st%blocks(1:st%nblocks)%count), st%g%nn]
+       ! the halo figures the scaling model reads (docs/scaling.md): ghost nodes (held, not
+       ! owned), nodes sent and received per exchange, neighbours
+       nmax = [sum(st%blocks(1:st%nblocks)%count), st%g%nn, st%g%nn - count(st%dom%owned), &
+            size(st%dom%send_nodes) + size(st%dom%recv_nodes), size(st%dom%nbr)]
        call comm_max(st%comm, nmax)
     end if
     if (st%dom%on) then
@@ -203,6 +206,9 @@ contains
          st%nranks, ' ranks, ', st%dom%rebalances, ' re-partitions; particles per rank now max ', nmax(1), &
          ', max/mean ', nmax(1) * st%nranks / max(g(2), 1.0_dp), '; grid nodes held per rank now max ', nmax(2), &
          ' of ', product(st%dom%n)
+    if (st%dom%on) write (output_unit, '(a,i0,a,i0,a,i0,a)') '  halo per rank now max: ', nmax(3), &
+         ' ghost nodes, ', nmax(4), ' nodes sent + received per exchange (2 exchanges each way per increment), ', &
+         nmax(5), ' neighbours'
     write (output_unit, '(a,i0,a,i0,a,i0,a)') '  particles ', nint(g(2)), ' (', st%n_in, ' in, ', nint(g(4)), ' out)'
     write (output_unit, '(a,4es14.6,a,es10.2)') '  mass      initial, in, out, now:', st%mass_initial, st%mass_in, &
          g(3), g(1), '  balance error', st%mass_initial + st%mass_in - g(3) - g(1)

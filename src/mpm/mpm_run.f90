@@ -22,7 +22,7 @@ module mpm_run
   use base_kinds, only: dp
   use error_report, only: error_t
   use model, only: model_t
-  use mpm_state, only: mpm_state_t, fx_walls, fx_outflow, fx_inflow
+  use mpm_state, only: mpm_state_t, fx_walls, fx_outflow, fx_inflow, fx_migration
   use mpm_musl, only: step_gravity, musl_transfer
   use mpm_stress_update, only: stress_update
   use mpm_flow, only: guard_particles, outflow, inflow
@@ -76,7 +76,9 @@ contains
     end if
     ! spatial decomposition: particles to the rank of their new position, re-partition if due
     if (st%dom%on) then
+       call fx%start(fx_migration)
        call domain_increment_end(m, st, regridded)
+       call fx%stop(fx_migration)
        if (regridded) then
           call setup_walls(m, st)
           call mark_wall_nodes(m, st)

@@ -12,7 +12,8 @@ module mpm_setup
   use mpm_migrate, only: decompose_initial
   use mpm_halo, only: domain_regrid
   use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
-       fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_side_friction
+       fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_side_friction, &
+       fx_exchange, fx_migration
   use output_effects, only: effects_t
   use mpm_grid, only: grid_init
   use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow
@@ -79,7 +80,7 @@ contains
          call setup_walls(m, st)
       end if
     end associate
-    call setup_effects(m, fx)
+    call setup_effects(m, st%nranks, fx)
   end subroutine mpm_setup_run
 
   !> The walls' node lists and the mirrored symmetry planes on the rank's grid (again after a
@@ -139,9 +140,13 @@ contains
 
   !> The MPM's effects, declared into the run's registry: active when the scene asks for them.
   !> Gravity and damping act inside the P2G/grid loops, VUSDFLD inside the material call: listed,
-  !> not timed apart.
-  subroutine setup_effects(m, fx)
+  !> not timed apart. On more than one rank the grid's sums over the ranks (all-reduce of the
+  !> replicated grid, or the halo sums of the spatial one) and the particles' migration are timed
+  !> as effects of their own: the scaling model (docs/scaling.md) needs them apart from the
+  !> particle work.
+  subroutine setup_effects(m, nranks, fx)
     type(model_t), intent(in) :: m
+    integer, intent(in) :: nranks
     type(effects_t), intent(inout) :: fx
     logical :: inflow, damping, gravity, side
     integer :: s
@@ -168,6 +173,8 @@ contains
     call fx%declare(fx_outflow, 'outflow', active=m%mpm%outflow)
     call fx%declare(fx_inflow, 'inflow', active=inflow)
     call fx%declare(fx_side_friction, 'side friction', active=side)
+    call fx%declare(fx_exchange, 'grid exchange', active=nranks > 1)
+    call fx%declare(fx_migration, 'migration', active=nranks > 1 .and. m%mpm%decomposition == decomposition_spatial)
   end subroutine setup_effects
 
   !> A regular lattice of ppc particles per cell and direction (aligned with the grid), kept
