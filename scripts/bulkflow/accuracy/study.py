@@ -1,0 +1,155 @@
+"""Run a family, measure each member, and write out/accuracy/<kind>/<kind>.{csv,png,json}.
+
+A kind is a dict (see wave_bar.KIND): its members (each with the size `h` and a label), a scene
+writer, a measure (the member's `value` and, for an exact reference, its relative `error`), and
+whether the reference is exact or Richardson-extrapolated from the three finest members.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import time
+from pathlib import Path
+
+from .convergence import order_from_errors, order_from_values, recommend, richardson
+from .runs import run_deck
+
+TARGETS = (0.01, 0.02, 0.05)
+
+
+def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str | None = None, log=print) -> dict:
+    out = Path(out)
+    runs = out / "runs"
+    rows = []
+    t_start = time.perf_counter()
+    for member in kind["members"](quick):
+        name = f"{kind['name'].replace('-', '_')}_{len(rows)}"
+        if "run" in kind:                  # a member that is more than one solver run (a search)
+            timing, res = kind["run"](member, runs, ranks, solver)
+        else:
+            timing = run_deck(kind["scene"](member), runs, name, ranks=ranks, solver=solver)
+            res = kind["measure"](timing.base, member)
+        work = res.pop("work_override", None)
+        row = {"label": member["label"], "h": member["h"], **{k: v for k, v in member.items()
+                                                              if k not in ("label", "h")},
+               "wall": timing.wall, "cpu": timing.cpu, "increments": timing.increments, "ranks": ranks,
+               **res}
+        # the work (element- or particle-steps) orders the members by cost independently of the
+        # machine's load; the wall and CPU times are what was measured
+        row["work"] = work if work is not None else timing.increments * (res.get("particles") or member["elements"])
+        rows.append(row)
+        log(f"  {member['label']:<40s} value {res['value']:.6g}"
+            + (f"  error {100 * res['error']:.3g} %" if res.get("error") is not None else "")
+            + f"  [{timing.wall:.2f} s wall, {timing.cpu:.2f} s cpu, {timing.increments} inc]")
+    summary = summarise(kind, rows)
+    summary["total_wall"] = time.perf_counter() - t_start
+    summary["quick"] = quick
+    write_outputs(kind, rows, summary, out)
+    return summary
+
+
+def summarise(kind: dict, rows: list[dict]) -> dict:
+    """Reference, observed order and the recommendations of a measured family (rows get `error`
+    filled in when the reference is extrapolated). The cheapest member is the one of least work
+    (increments × elements or particles): in one family the solver's time is proportional to it,
+    while the measured wall time of a short run is mostly start-up and the machine's load."""
+    h = [r["h"] for r in rows]
+    summary = {"kind": kind["name"], "title": kind["title"], "quantity": kind["quantity"],
+               "error_measure": kind["error_measure"], "expected_order": kind["expected_order"],
+               "reference_kind": kind["reference"]}
+    if kind["reference"] == "exact":
+        summary["observed_order"] = order_from_errors(h, [r["error"] for r in rows])
+        summary["reference"] = kind.get("exact_value")
+    else:
+        values = [r["value"] for r in rows]
+        try:
+            rich = richardson(h, values)
+        except ValueError as exc:
+            # no observed order: report against the finest member, say so, recommend nothing
+            summary.update(observed_order=float("nan"), reference=None, reference_uncertainty=None,
+                           gci_finest=None, reference_note=str(exc))
+            finest = min(rows, key=lambda r: r["h"])
+            for r in rows:
+                r["error"] = abs(r["value"] / finest["value"] - 1)
+            summary.update(finest_error=None, finest_label=finest["label"], members=rows,
+                           recommendations=[{"target": t, "label": None, "h": None, "wall": None,
+                                             "line": f"for ±{100 * t:g} % {kind['quantity']}: no reference "
+                                                     "(convergence not monotone), no recommendation"}
+                                            for t in TARGETS])
+            return summary
+        summary["observed_order"] = rich.order
+        summary["reference"] = rich.value
+        summary["reference_uncertainty"] = rich.uncertainty
+        summary["gci_finest"] = rich.gci
+        for r in rows:
+            r["error"] = abs(r["value"] - rich.value) / abs(rich.value)
+    finest = min(rows, key=lambda r: r["h"])
+    summary["finest_error"] = finest["error"]
+    summary["finest_label"] = finest["label"]
+    summary["recommendations"] = []
+    for target in TARGETS:
+        pick = recommend(rows, target, key_cost="work")
+        if pick is None:
+            line = f"for ±{100 * target:g} % {kind['quantity']}: no member of this family reaches it"
+        else:
+            line = (f"for ±{100 * target:g} % {kind['quantity']}: {pick['label']}, "
+                    f"{pick['wall']:.3g} s on {pick['ranks']} rank(s) ({pick['cpu']:.3g} s CPU; "
+                    f"error {100 * pick['error']:.2g} %)")
+        summary["recommendations"].append({"target": target, "label": pick and pick["label"],
+                                           "h": pick and pick["h"], "wall": pick and pick["wall"],
+                                           "line": line})
+    summary["members"] = rows
+    return summary
+
+
+def write_outputs(kind: dict, rows: list[dict], summary: dict, out: Path) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    stem = out / kind["name"]
+    keys = []
+    for r in rows:
+        keys += [k for k in r if k not in keys]
+    with open(f"{stem}.csv", "w", newline="") as handle:
+        w = csv.DictWriter(handle, fieldnames=keys)
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+    Path(f"{stem}.json").write_text(json.dumps(summary, indent=2, default=_json_default) + "\n")
+    plot(kind, rows, summary, Path(f"{stem}.png"))
+
+
+def _json_default(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return float(x)
+
+
+def plot(kind: dict, rows: list[dict], summary: dict, path: Path) -> None:
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    wall = [r["wall"] for r in rows]
+    err = [100 * max(r["error"], 1e-12) for r in rows]
+    ax1.loglog(wall, err, "o-")
+    for r, w, e in zip(rows, wall, err):
+        ax1.annotate(f"h {r['h']:.3g}", (w, e), textcoords="offset points", xytext=(4, 4), fontsize=8)
+    for target in TARGETS:
+        ax1.axhline(100 * target, color="grey", lw=0.6, ls="--")
+    ax1.set_xlabel(f"wall time per run, s ({rows[0]['ranks']} rank(s))")
+    ax1.set_ylabel("relative error, %")
+    ax1.set_title(f"{kind['name']}: error against wall time", fontsize=10)
+    h = [r["h"] for r in rows]
+    ax2.loglog(h, err, "s-", label="measured")
+    p = summary["observed_order"]
+    if p and math.isfinite(p):
+        hf, ef = h[-1], err[-1]
+        ax2.loglog(h, [ef * (x / hf) ** p for x in h], "k:", label=f"observed order {p:.2f}")
+    ax2.set_xlabel(f"{kind['parameter']}, {kind['parameter_unit']}")
+    ax2.set_ylabel("relative error, %")
+    ax2.legend(fontsize=8)
+    ax2.set_title(kind["error_measure"][:70], fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
