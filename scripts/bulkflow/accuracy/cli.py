@@ -48,7 +48,8 @@ def main(argv=None) -> int:
         ref = (f"Richardson {s['reference']:.6g} ± {s['reference_uncertainty']:.2g} "
                f"(GCI {100 * s['gci_finest']:.2g} %)")
     print(f"reference: {ref}; error measure: {s['error_measure']}")
-    print(f"observed order (three finest): {s['observed_order']:.2f}; expected {s['expected_order']}")
+    note = "" if s.get("monotone", True) else " (the error does not fall over the three finest: no order)"
+    print(f"observed order (three finest): {s['observed_order']:.2f}{note}; expected {s['expected_order']}")
     fe = "n/a" if s["finest_error"] is None else f"{100 * s['finest_error']:.3g} %"
     print(f"finest ({s['finest_label']}): error {fe}; total wall {s['total_wall']:.1f} s")
     for rec in s["recommendations"]:

@@ -16,13 +16,11 @@ three finest do not converge monotonically there is no observed order and the co
 """
 from __future__ import annotations
 
-import re
-from pathlib import Path
-
 import numpy as np
 
 from ..mpm.discharge import mean_discharge_rate
 from ..mpm.hopper_run import scene_text
+from .runs import particles_from_log
 
 EDGE_CELLS = [1.5, 2.5, 3.5, 4.5]
 QUICK_EDGE_CELLS = [1.5, 2.5, 3.5]
@@ -47,9 +45,7 @@ def scene(member: dict) -> str:
 def measure(base, member: dict) -> dict:
     hist = np.genfromtxt(f"{base}_history.csv", delimiter=",", names=True)
     mdr = 2.0 * float(mean_discharge_rate(hist))
-    log = Path(f"{base}.log").read_text()
-    m = re.search(r"(\d+) particles,", log)
-    return {"value": mdr, "particles": int(m.group(1)) if m else 0}
+    return {"value": mdr, "particles": particles_from_log(base)}
 
 
 KIND = {

@@ -17,7 +17,7 @@ import re
 
 import numpy as np
 
-from .runs import REPO
+from .runs import REPO, particles_from_log
 
 ALPHA, MU, G = math.radians(30.0), 0.2, 9.81
 EXACT = G * (math.sin(ALPHA) - MU * math.cos(ALPHA))
@@ -48,7 +48,7 @@ def measure(base, member: dict) -> dict:
     vs = hist["VCM1"] * math.cos(ALPHA) - hist["VCM2"] * math.sin(ALPHA)
     m = t >= 0.1
     acc = float(np.polyfit(t[m], vs[m], 1)[0])
-    return {"value": acc, "error": abs(acc / EXACT - 1)}
+    return {"value": acc, "error": abs(acc / EXACT - 1), "particles": particles_from_log(base)}
 
 
 KIND = {

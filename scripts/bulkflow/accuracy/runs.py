@@ -53,6 +53,12 @@ def run_deck(text: str, workdir: Path, name: str, ranks: int = 1, solver: str | 
     return Timing(wall, cpu, int(m.group(1)) if m else 0, base)
 
 
+def particles_from_log(base) -> int:
+    """Number of particles an MPM run printed (BASE.log written by run_deck), 0 if none."""
+    m = re.search(r"(\d+) particles,", Path(f"{base}.log").read_text())
+    return int(m.group(1)) if m else 0
+
+
 _VERIFICATION = None
 
 

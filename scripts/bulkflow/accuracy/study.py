@@ -61,6 +61,8 @@ def summarise(kind: dict, rows: list[dict]) -> dict:
                "reference_kind": kind["reference"]}
     if kind["reference"] == "exact":
         summary["observed_order"] = order_from_errors(h, [r["error"] for r in rows])
+        fine = sorted(rows, key=lambda r: r["h"])[:3]
+        summary["monotone"] = bool(fine[0]["error"] < fine[1]["error"] < fine[2]["error"])
         summary["reference"] = kind.get("exact_value")
     else:
         values = [r["value"] for r in rows]
