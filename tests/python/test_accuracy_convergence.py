@@ -40,7 +40,7 @@ def test_oscillatory_convergence_is_refused():
     h = [0.4, 0.2, 0.1]
     f = [1.0, 1.2, 1.1]
     assert math.isnan(order_from_values(h, f))
-    with pytest.raises(ValueError, match="not monotone"):
+    with pytest.raises(ValueError, match="oscillatory"):
         richardson(h, f)
     # with a given order it extrapolates anyway: f1 + (f1 - f2)/(2^2 - 1)
     assert richardson(h, f, order=2.0).value == pytest.approx(1.1 + (1.1 - 1.2) / 3)
@@ -65,3 +65,12 @@ def test_recommend_picks_cheapest_within_target():
     assert recommend(members, 0.02)["label"] == "odd"
     assert recommend(members, 0.005)["label"] == "fine"
     assert recommend(members, 0.001) is None
+
+
+def test_differences_growing_with_refinement_have_no_order():
+    # monotone values whose differences grow as h falls (a drift, not convergence): no p > 0
+    h = [0.1, 0.07, 0.05]
+    f = [0.3746, 0.3716, 0.3658]
+    assert math.isnan(order_from_values(h, f))
+    with pytest.raises(ValueError, match="asymptotic range"):
+        richardson(h, f)

@@ -54,7 +54,7 @@ def main(argv=None) -> int:
     print(f"finest ({s['finest_label']}): error {fe}; total wall {s['total_wall']:.1f} s")
     for rec in s["recommendations"]:
         print(rec["line"])
-    print(f"wrote {out / kind['name']}.csv, .png, .json")
+    print(f"wrote {out / kind['name']}.csv, .png, .json, .md")
     return 0
 
 

@@ -82,8 +82,11 @@ def richardson(h, f, order: float | None = None, safety: float = 1.25) -> Richar
     hs, fs = _finest_three(h, f)
     p = order if order is not None else order_from_values(h, f)
     if not (p > 0):
-        raise ValueError(f"no observed order from {fs.tolist()} at h = {hs.tolist()}: "
-                         "convergence is not monotone; refine further or give the order")
+        d21, d32 = fs[1] - fs[0], fs[2] - fs[1]
+        why = ("the differences change sign (oscillatory convergence)" if d21 * d32 <= 0 else
+               "the differences do not shrink fast enough with refinement (not in the asymptotic range)")
+        raise ValueError(f"no observed order from {fs.tolist()} at h = {hs.tolist()}: {why}; "
+                         "refine further or give the order")
     r = hs[1] / hs[0]
     factor = r ** p - 1
     value = fs[0] + (fs[0] - fs[1]) / factor

@@ -22,8 +22,8 @@ from ..mpm.discharge import mean_discharge_rate
 from ..mpm.hopper_run import scene_text
 from .runs import particles_from_log
 
-EDGE_CELLS = [1.5, 2.5, 3.5, 4.5]
-QUICK_EDGE_CELLS = [1.5, 2.5, 3.5]
+EDGE_CELLS = [1.5, 2.5, 3.5, 4.5, 5.5]
+QUICK_EDGE_CELLS = [1.5, 2.5, 3.5, 4.5, 5.5]
 FULL = dict(height=3.0, fill_time=1.0, discharge_time=1.5)
 QUICK = dict(height=1.0, fill_time=0.5, ramp=0.3, discharge_time=1.0)
 

@@ -78,7 +78,7 @@ def summarise(kind: dict, rows: list[dict]) -> dict:
             summary.update(finest_error=None, finest_label=finest["label"], members=rows,
                            recommendations=[{"target": t, "label": None, "h": None, "wall": None,
                                              "line": f"for ±{100 * t:g} % {kind['quantity']}: no reference "
-                                                     "(convergence not monotone), no recommendation"}
+                                                     "(no observed order), no recommendation"}
                                             for t in TARGETS])
             return summary
         summary["observed_order"] = rich.order
@@ -118,7 +118,28 @@ def write_outputs(kind: dict, rows: list[dict], summary: dict, out: Path) -> Non
         for r in rows:
             w.writerow(r)
     Path(f"{stem}.json").write_text(json.dumps(summary, indent=2, default=_json_default) + "\n")
+    Path(f"{stem}.md").write_text(markdown(kind, rows, summary))
     plot(kind, rows, summary, Path(f"{stem}.png"))
+
+
+def markdown(kind: dict, rows: list[dict], summary: dict) -> str:
+    """The family as the Markdown table docs/accuracy.md shows, with the summary lines."""
+    lines = [f"| member | {kind['parameter']} ({kind['parameter_unit']}) | value | error | increments | work | "
+             f"wall (s) | CPU (s) |", "|---|---|---|---|---|---|---|---|"]
+    for r in sorted(rows, key=lambda r: -r["h"]):
+        lines.append(f"| {r['label']} | {r['h']:.4g} | {r['value']:.6g} | {100 * r['error']:.3g} % | "
+                     f"{r['increments']} | {r['work']:.3g} | {r['wall']:.3g} | {r['cpu']:.3g} |")
+    p = summary["observed_order"]
+    ref = "exact" if summary["reference_kind"] == "exact" else (
+        "none (no observed order)" if summary["reference"] is None else
+        f"Richardson {summary['reference']:.6g} ± {summary['reference_uncertainty']:.2g} "
+        f"(GCI {100 * summary['gci_finest']:.2g} %)")
+    lines += ["", f"Reference: {ref}. Observed order (three finest): "
+              + ("none" if p is None or p != p else f"{p:.2f}")
+              + ("" if summary.get("monotone", True) else " (the error does not fall: no order)")
+              + f". Total wall time {summary['total_wall']:.0f} s on {rows[0]['ranks']} rank(s).", ""]
+    lines += [f"- {r['line']}" for r in summary["recommendations"]]
+    return "\n".join(lines) + "\n"
 
 
 def _json_default(x):
