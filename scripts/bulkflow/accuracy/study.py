@@ -172,7 +172,8 @@ def plot(kind: dict, rows: list[dict], summary: dict, path: Path) -> None:
     ax2.set_xlabel(f"{kind['parameter']}, {kind['parameter_unit']}")
     ax2.set_ylabel("relative error, %")
     ax2.legend(fontsize=8)
-    ax2.set_title(kind["error_measure"][:70], fontsize=8)
+    ref = "exact" if kind["reference"] == "exact" else "Richardson-extrapolated"
+    ax2.set_title(f"{kind['quantity']}: error against {kind['parameter']} ({ref} reference)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
