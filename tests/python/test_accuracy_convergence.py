@@ -74,3 +74,14 @@ def test_differences_growing_with_refinement_have_no_order():
     assert math.isnan(order_from_values(h, f))
     with pytest.raises(ValueError, match="asymptotic range"):
         richardson(h, f)
+
+
+def test_low_observed_order_is_not_extrapolated():
+    # f = f0 + C h^0.2: a positive order, but too low to trust (the correction would be ~9x the
+    # last difference at r = 1.25): refused unless the order is given
+    h = [0.05, 0.04, 0.032]
+    f = [1.0 + x ** 0.2 for x in h]
+    assert order_from_values(h, f) == pytest.approx(0.2, rel=1e-8)
+    with pytest.raises(ValueError, match="below 0.5"):
+        richardson(h, f)
+    assert richardson(h, f, min_order=0.1).value == pytest.approx(1.0, rel=1e-8)

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from . import arching_cow, hopper_mdr, incline, k0_column, wave_bar
-from .study import run_family
+from .study import resummarise, run_family
 
 KINDS = {k["name"]: k for k in (wave_bar.KIND, wave_bar.KIND_BV, k0_column.KIND, incline.KIND, hopper_mdr.KIND,
                                  arching_cow.KIND)}
@@ -24,6 +24,8 @@ def main(argv=None) -> int:
     parser.add_argument("--solver", default=None, help="bulkflow binary (default BULKFLOW_BIN or build/bin/bulkflow)")
     parser.add_argument("--criterion", default=None,
                         help="arching-cow only: the flow criterion, passed to bulkflow.arching when it takes one")
+    parser.add_argument("--summarise-only", action="store_true",
+                        help="no runs: the summary and outputs again from the measured rows of OUT/KIND.json")
     args = parser.parse_args(argv)
     if args.kind not in KINDS:
         extra = f" ({args.kind} is not implemented yet)" if args.kind in NOT_DONE else ""
@@ -39,7 +41,12 @@ def main(argv=None) -> int:
         arching_cow.CRITERION = args.criterion
     out = args.out or Path("out") / "accuracy" / args.kind
     print(f"{kind['name']}: {kind['title']}{' (quick)' if args.quick else ''}")
-    s = run_family(kind, args.quick, out, ranks=args.ranks, solver=args.solver)
+    if args.summarise_only:
+        if not (out / f"{kind['name']}.json").exists():
+            parser.error(f"--summarise-only: {out / kind['name']}.json does not exist (run the family first)")
+        s = resummarise(kind, out)
+    else:
+        s = run_family(kind, args.quick, out, ranks=args.ranks, solver=args.solver)
     if s["reference_kind"] == "exact":
         ref = "exact"
     elif s["reference"] is None:

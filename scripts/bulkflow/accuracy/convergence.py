@@ -73,20 +73,33 @@ class Richardson:
     uncertainty: float    #: GCI as an absolute band on the extrapolated value: |f1| · gci
 
 
-def richardson(h, f, order: float | None = None, safety: float = 1.25) -> Richardson:
+def _show(values) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
+
+
+MIN_ORDER = 0.5   #: below it the extrapolation is refused (see richardson)
+
+
+def richardson(h, f, order: float | None = None, safety: float = 1.25, min_order: float = MIN_ORDER) -> Richardson:
     """Richardson (1911) extrapolation from the two finest members with the observed order of the
     three finest (or `order` if given): f_ext = f1 + (f1 − f2)/(r^p − 1), r = h2/h1. The grid
     convergence index of the finest member (Roache 1998) GCI = Fs |(f2 − f1)/f1| / (r^p − 1), with
     the safety factor Fs = 1.25 for three or more members. Raises ValueError when no order can be
-    observed (oscillatory or stalled convergence) and none is given."""
+    observed (oscillatory or stalled convergence) and none is given, or when the observed order is
+    below `min_order`: the correction (f1 − f2)/(r^p − 1) then multiplies the last difference by
+    more than 1/(r^0.5 − 1) (2.4 for r = 2, 8.5 for r = 1.25), so the reference would be the
+    members' noise amplified, not a limit."""
     hs, fs = _finest_three(h, f)
     p = order if order is not None else order_from_values(h, f)
     if not (p > 0):
         d21, d32 = fs[1] - fs[0], fs[2] - fs[1]
         why = ("the differences change sign (oscillatory convergence)" if d21 * d32 <= 0 else
                "the differences do not shrink fast enough with refinement (not in the asymptotic range)")
-        raise ValueError(f"no observed order from {fs.tolist()} at h = {hs.tolist()}: {why}; "
+        raise ValueError(f"no observed order from {_show(fs)} at h = {_show(hs)}: {why}; "
                          "refine further or give the order")
+    if order is None and p < min_order:
+        raise ValueError(f"observed order {p:.2f} from {_show(fs)} at h = {_show(hs)} is below {min_order}: "
+                         "not in the asymptotic range, no extrapolation")
     r = hs[1] / hs[0]
     factor = r ** p - 1
     value = fs[0] + (fs[0] - fs[1]) / factor
