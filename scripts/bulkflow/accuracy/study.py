@@ -172,31 +172,44 @@ def _json_default(x):
 
 
 def plot(kind: dict, rows: list[dict], summary: dict, path: Path) -> None:
+    """Left: error against wall time (targets dashed); right: error against h with the observed
+    order. Without a reference (no usable order) the values themselves are drawn instead."""
     os.environ.setdefault("MPLBACKEND", "Agg")
     import matplotlib.pyplot as plt
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    rows = sorted(rows, key=lambda r: -r["h"])
     wall = [r["wall"] for r in rows]
-    err = [100 * max(r["error"], 1e-12) for r in rows]
-    ax1.loglog(wall, err, "o-")
-    for r, w, e in zip(rows, wall, err):
-        ax1.annotate(f"h {r['h']:.3g}", (w, e), textcoords="offset points", xytext=(4, 4), fontsize=8)
-    for target in TARGETS:
-        ax1.axhline(100 * target, color="grey", lw=0.6, ls="--")
-    ax1.set_xlabel(f"wall time per run, s ({rows[0]['ranks']} rank(s))")
-    ax1.set_ylabel("relative error, %")
-    ax1.set_title(f"{kind['name']}: error against wall time", fontsize=10)
     h = [r["h"] for r in rows]
-    ax2.loglog(h, err, "s-", label="measured")
-    p = summary["observed_order"]
-    if p and math.isfinite(p):
-        hf, ef = h[-1], err[-1]
-        ax2.loglog(h, [ef * (x / hf) ** p for x in h], "k:", label=f"observed order {p:.2f}")
+    no_ref = summary["reference_kind"] != "exact" and summary["reference"] is None
+    if no_ref:
+        y = [r["value"] for r in rows]
+        ax1.semilogx(wall, y, "o-")
+        ax2.semilogx(h, y, "s-", label="measured")
+        for ax in (ax1, ax2):
+            ax.set_ylabel(kind["quantity"])
+        ax2.set_title(f"{kind['quantity']} against {kind['parameter']}: no usable observed order, "
+                      "no reference", fontsize=9)
+    else:
+        y = [100 * max(r["error"], 1e-12) for r in rows]
+        ax1.loglog(wall, y, "o-")
+        for target in TARGETS:
+            ax1.axhline(100 * target, color="grey", lw=0.6, ls="--")
+        ax2.loglog(h, y, "s-", label="measured")
+        p = summary["observed_order"]
+        if p and math.isfinite(p):
+            ax2.loglog(h, [y[-1] * (x / h[-1]) ** p for x in h], "k:", label=f"observed order {p:.2f}")
+        for ax in (ax1, ax2):
+            ax.set_ylabel("relative error, %")
+        ref = "exact" if kind["reference"] == "exact" else "Richardson-extrapolated"
+        ax2.set_title(f"{kind['quantity']}: error against {kind['parameter']} ({ref} reference)", fontsize=9)
+    for r, w, v in zip(rows, wall, y):
+        ax1.annotate(f"{kind['parameter']} {r['h']:.3g}", (w, v), textcoords="offset points", xytext=(4, 4),
+                     fontsize=8)
+    ax1.set_xlabel(f"wall time per member, s ({rows[0]['ranks']} rank(s); shared machine)")
+    ax1.set_title(f"{kind['name']}: against wall time", fontsize=10)
     ax2.set_xlabel(f"{kind['parameter']}, {kind['parameter_unit']}")
-    ax2.set_ylabel("relative error, %")
     ax2.legend(fontsize=8)
-    ref = "exact" if kind["reference"] == "exact" else "Richardson-extrapolated"
-    ax2.set_title(f"{kind['quantity']}: error against {kind['parameter']} ({ref} reference)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
