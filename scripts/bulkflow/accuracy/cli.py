@@ -46,7 +46,11 @@ def main(argv=None) -> int:
             parser.error(f"--summarise-only: {out / kind['name']}.json does not exist (run the family first)")
         s = resummarise(kind, out)
     else:
-        s = run_family(kind, args.quick, out, ranks=args.ranks, solver=args.solver)
+        try:
+            s = run_family(kind, args.quick, out, ranks=args.ranks, solver=args.solver)
+        except (FileNotFoundError, RuntimeError) as exc:      # no solver, or a run that failed
+            print(f"bulkflow-accuracy: {exc}", file=sys.stderr)
+            return 2
     if s["reference_kind"] == "exact":
         ref = "exact"
     elif s["reference"] is None:
