@@ -65,6 +65,11 @@ def main(argv=None) -> int:
     print(f"finest ({s['finest_label']}): error {fe}; total wall {s['total_wall']:.1f} s")
     for rec in s["recommendations"]:
         print(rec["line"])
+    for key, e in s.get("also", {}).items():
+        ref = (f"Richardson {e['reference']:.6g} ± {e['uncertainty']:.2g} (observed order {e['observed_order']:.2f}, "
+               f"finest {100 * e['finest_error']:.2g} % from it)" if e["reference"] is not None
+               else f"no reference: {e['note']}")
+        print(f"also {e['what']}: {ref}")
     print(f"wrote {out / kind['name']}.csv, .png, .json, .md")
     return 0
 

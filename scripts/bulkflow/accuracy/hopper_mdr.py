@@ -6,7 +6,8 @@ steady) written by bulkflow.mpm.hopper_run.scene_text, with cells h = 0.125/n m 
 3.5, … so that the outlet edge x = b/2 always falls mid-cell (bulkflow-mpm-study convergence
 explains why mixing edge offsets makes the series jump). The steady MDR is
 bulkflow.mpm.discharge.mean_discharge_rate (regression of the discharged mass from 0.5 s after
-opening); the full hopper's is twice the half model's.
+opening); the full hopper's is twice the half model's. Also measured, with its own observed
+order and reference: the normal force on the discharging wall (wall_force).
 
 No closed form: the reference is Richardson-extrapolated from the three finest members, with the
 grid convergence index as its uncertainty; each member's error is |MDR_h/MDR_ext − 1|. When the
@@ -39,13 +40,27 @@ def members(quick: bool) -> list[dict]:
 
 def scene(member: dict) -> str:
     kw = dict(QUICK if member["quick_case"] else FULL)
-    return scene_text(cell=member["cell"], ppc=2, shape="GIMP", field_frames=2, **kw)
+    # 2 particle frames in the fill step, 6 in the discharge: the wall force averages the last 3
+    return scene_text(cell=member["cell"], ppc=2, shape="GIMP", field_frames=2, discharge_frames=6, **kw)
+
+
+def wall_force(base, cell: float) -> float:
+    """Normal force per metre of depth on the discharging inclined wall, N/m: the wall normal
+    stress of the particles 1-2 cells from the wall (bulkflow.mpm.paths.wall_path, bins of 0.1 m
+    whatever the cell) summed along the wall, averaged over the last 3 particle frames."""
+    import h5py
+
+    from ..mpm.paths import frames, wall_path
+
+    with h5py.File(f"{base}.h5", "r") as f:
+        wp = wall_path(frames(f, 3), cell, 30.0, 0.25, bin_width=0.1)
+    return float(np.nansum(wp[:, 2]) * 0.1)
 
 
 def measure(base, member: dict) -> dict:
     hist = np.genfromtxt(f"{base}_history.csv", delimiter=",", names=True)
     mdr = 2.0 * float(mean_discharge_rate(hist))
-    return {"value": mdr, "particles": particles_from_log(base)}
+    return {"value": mdr, "wall_force": wall_force(base, member["cell"]), "particles": particles_from_log(base)}
 
 
 KIND = {
@@ -56,6 +71,7 @@ KIND = {
     "quantity": "MDR",
     "error_measure": "|MDR_h / MDR_Richardson − 1|, MDR the full hopper's steady discharge rate, kg/s/m",
     "reference": "richardson",
+    "also": {"wall_force": "discharging wall normal force, N/m (last 3 frames)"},
     "members": members,
     "scene": scene,
     "measure": measure,

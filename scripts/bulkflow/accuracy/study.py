@@ -57,7 +57,7 @@ def resummarise(kind: dict, out: Path) -> dict:
     old = json.loads(Path(f"{stem}.json").read_text())
     keep = ("label", "h", "wall", "cpu", "increments", "ranks", "work", "value", "particles", "elements",
             "n", "cell", "n_arc", "tol", "no_flow", "flow", "runs", "quick_case", "sv_l2", "sv_centroid",
-            "k0", "settlement")
+            "k0", "settlement", "wall_force")
     rows = [{k: m[k] for k in keep if k in m} for m in old["members"]]
     if kind["reference"] == "exact":
         for r, m in zip(rows, old["members"]):
@@ -69,13 +69,34 @@ def resummarise(kind: dict, out: Path) -> dict:
     return summary
 
 
+def also_summary(kind: dict, rows: list[dict]) -> dict:
+    """Observed order and Richardson reference of the kind's secondary quantities (`also`)."""
+    h = [r["h"] for r in rows]
+    out = {}
+    for key, what in kind.get("also", {}).items():
+        values = [r.get(key) for r in rows]
+        if any(v is None for v in values):
+            continue
+        entry = {"what": what, "observed_order": order_from_values(h, values)}
+        try:
+            rich = richardson(h, values)
+            entry.update(reference=rich.value, uncertainty=rich.uncertainty, gci=rich.gci)
+            finest = min(rows, key=lambda r: r["h"])
+            entry["finest_error"] = abs(finest[key] / rich.value - 1)
+        except ValueError as exc:
+            entry.update(reference=None, note=str(exc))
+        out[key] = entry
+    return out
+
+
 def summarise(kind: dict, rows: list[dict]) -> dict:
     """Reference, observed order and the recommendations of a measured family (rows get `error`
     filled in when the reference is extrapolated). The cheapest member is the one of least work
     (increments × elements or particles): in one family the solver's time is proportional to it,
     while the measured wall time of a short run is mostly start-up and the machine's load."""
     h = [r["h"] for r in rows]
-    summary = {"kind": kind["name"], "title": kind["title"], "quantity": kind["quantity"],
+    summary = {"also": also_summary(kind, rows),
+               "kind": kind["name"], "title": kind["title"], "quantity": kind["quantity"],
                "error_measure": kind["error_measure"], "expected_order": kind["expected_order"],
                "reference_kind": kind["reference"]}
     if kind["reference"] == "exact":
@@ -162,6 +183,10 @@ def markdown(kind: dict, rows: list[dict], summary: dict) -> str:
               + ("" if summary.get("monotone", True) else " (the error does not fall: no order)")
               + f". Total wall time {summary['total_wall']:.0f} s on {rows[0]['ranks']} rank(s).", ""]
     lines += [f"- {r['line']}" for r in summary["recommendations"]]
+    for key, e in summary.get("also", {}).items():
+        ref = (f"Richardson {e['reference']:.6g} ± {e['uncertainty']:.2g}, finest {100 * e['finest_error']:.2g} % "
+               f"from it" if e["reference"] is not None else f"no reference — {e['note']}")
+        lines.append(f"- also {e['what']} (CSV column `{key}`): {ref}")
     return "\n".join(lines) + "\n"
 
 
