@@ -166,11 +166,14 @@ def write_outputs(kind: dict, rows: list[dict], summary: dict, out: Path) -> Non
 
 def markdown(kind: dict, rows: list[dict], summary: dict) -> str:
     """The family as the Markdown table docs/accuracy.md shows, with the summary lines."""
-    lines = [f"| member | {kind['parameter']} ({kind['parameter_unit']}) | value | error | increments | work | "
-             f"wall (s) | CPU (s) |", "|---|---|---|---|---|---|---|---|"]
+    also = [k for k in kind.get("also", {}) if all(k in r for r in rows)]
+    lines = [f"| member | {kind['parameter']} ({kind['parameter_unit']}) | value | error | "
+             + "".join(f"{k} | " for k in also) + "increments | work | wall (s) | CPU (s) |",
+             "|---|---|---|---|" + "---|" * len(also) + "---|---|---|---|"]
     for r in sorted(rows, key=lambda r: -r["h"]):
         lines.append(f"| {r['label']} | {r['h']:.4g} | {r['value']:.6g} | {100 * r['error']:.3g} % | "
-                     f"{r['increments']} | {r['work']:.3g} | {r['wall']:.3g} | {r['cpu']:.3g} |")
+                     + "".join(f"{r[k]:.5g} | " for k in also)
+                     + f"{r['increments']} | {r['work']:.3g} | {r['wall']:.3g} | {r['cpu']:.3g} |")
     p = summary["observed_order"]
     ref = "exact" if summary["reference_kind"] == "exact" else (
         f"none — {summary['reference_note']}" if summary["reference"] is None else
