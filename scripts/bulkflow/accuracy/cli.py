@@ -16,7 +16,7 @@ NOT_DONE = ("bin-tss",)
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="bulkflow-accuracy", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="bulkflow-accuracy", description=" ".join(__doc__.split()))
     parser.add_argument("kind", help=f"one of {', '.join(KINDS)}")
     parser.add_argument("--quick", action="store_true", help="the smaller family (seconds to minutes)")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default out/accuracy/KIND)")
