@@ -1,0 +1,243 @@
+"""Run a family, measure each member, and write out/accuracy/<kind>/<kind>.{csv,png,json}.
+
+A kind is a dict (see wave_bar.KIND): its members (each with the size `h` and a label), a scene
+writer, a measure (the member's `value` and, for an exact reference, its relative `error`), and
+whether the reference is exact or Richardson-extrapolated from the three finest members.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import time
+from pathlib import Path
+
+from .convergence import order_from_errors, order_from_values, recommend, richardson
+from .runs import run_deck
+
+TARGETS = (0.01, 0.02, 0.05)
+
+
+def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str | None = None, log=print) -> dict:
+    out = Path(out)
+    runs = out / "runs"
+    rows = []
+    t_start = time.perf_counter()
+    for member in kind["members"](quick):
+        name = f"{kind['name'].replace('-', '_')}_{len(rows)}"
+        if "run" in kind:                  # a member that is more than one solver run (a search)
+            timing, res = kind["run"](member, runs, ranks, solver)
+        else:
+            timing = run_deck(kind["scene"](member), runs, name, ranks=ranks, solver=solver)
+            res = kind["measure"](timing.base, member)
+        work = res.pop("work_override", None)
+        row = {"label": member["label"], "h": member["h"], **{k: v for k, v in member.items()
+                                                              if k not in ("label", "h")},
+               "wall": timing.wall, "cpu": timing.cpu, "increments": timing.increments, "ranks": ranks,
+               **res}
+        # the work (element- or particle-steps) orders the members by cost independently of the
+        # machine's load; the wall and CPU times are what was measured
+        row["work"] = work if work is not None else timing.increments * (res.get("particles") or member["elements"])
+        rows.append(row)
+        log(f"  {member['label']:<40s} value {res['value']:.6g}"
+            + (f"  error {100 * res['error']:.3g} %" if res.get("error") is not None else "")
+            + f"  [{timing.wall:.2f} s wall, {timing.cpu:.2f} s cpu, {timing.increments} inc]")
+    summary = summarise(kind, rows)
+    summary["total_wall"] = time.perf_counter() - t_start
+    summary["quick"] = quick
+    write_outputs(kind, rows, summary, out)
+    return summary
+
+
+def resummarise(kind: dict, out: Path) -> dict:
+    """Summary and outputs again from the measured rows of an earlier run's <kind>.json (no solver
+    run): for a changed summary rule without repeating a long family."""
+    stem = Path(out) / kind["name"]
+    old = json.loads(Path(f"{stem}.json").read_text())
+    keep = ("label", "h", "wall", "cpu", "increments", "ranks", "work", "value", "particles", "elements",
+            "n", "cell", "n_arc", "tol", "no_flow", "flow", "runs", "quick_case", "sv_l2", "sv_centroid",
+            "k0", "settlement", "wall_force")
+    rows = [{k: m[k] for k in keep if k in m} for m in old["members"]]
+    if kind["reference"] == "exact":
+        for r, m in zip(rows, old["members"]):
+            r["error"] = m["error"]
+    summary = summarise(kind, rows)
+    summary["total_wall"] = old["total_wall"]
+    summary["quick"] = old.get("quick")
+    write_outputs(kind, rows, summary, Path(out))
+    return summary
+
+
+def also_summary(kind: dict, rows: list[dict]) -> dict:
+    """Observed order and Richardson reference of the kind's secondary quantities (`also`)."""
+    h = [r["h"] for r in rows]
+    out = {}
+    for key, what in kind.get("also", {}).items():
+        values = [r.get(key) for r in rows]
+        if any(v is None for v in values):
+            continue
+        entry = {"what": what, "observed_order": order_from_values(h, values)}
+        try:
+            rich = richardson(h, values)
+            entry.update(reference=rich.value, uncertainty=rich.uncertainty, gci=rich.gci)
+            finest = min(rows, key=lambda r: r["h"])
+            entry["finest_error"] = abs(finest[key] / rich.value - 1)
+        except ValueError as exc:
+            entry.update(reference=None, note=str(exc))
+        out[key] = entry
+    return out
+
+
+def summarise(kind: dict, rows: list[dict]) -> dict:
+    """Reference, observed order and the recommendations of a measured family (rows get `error`
+    filled in when the reference is extrapolated). The cheapest member is the one of least work
+    (increments × elements or particles): in one family the solver's time is proportional to it,
+    while the measured wall time of a short run is mostly start-up and the machine's load."""
+    h = [r["h"] for r in rows]
+    summary = {"also": also_summary(kind, rows),
+               "kind": kind["name"], "title": kind["title"], "quantity": kind["quantity"],
+               "error_measure": kind["error_measure"], "expected_order": kind["expected_order"],
+               "reference_kind": kind["reference"]}
+    if kind["reference"] == "exact":
+        summary["observed_order"] = order_from_errors(h, [r["error"] for r in rows])
+        fine = sorted(rows, key=lambda r: r["h"])[:3]
+        summary["monotone"] = bool(fine[0]["error"] < fine[1]["error"] < fine[2]["error"])
+        summary["reference"] = kind.get("exact_value")
+    else:
+        values = [r["value"] for r in rows]
+        try:
+            rich = richardson(h, values)
+        except ValueError as exc:
+            # no observed order: report against the finest member, say so, recommend nothing
+            summary.update(observed_order=order_from_values(h, values), reference=None, reference_uncertainty=None,
+                           gci_finest=None, reference_note=str(exc))
+            finest, second = sorted(rows, key=lambda r: r["h"])[:2]
+            spread = abs(second["value"] / finest["value"] - 1)
+            for r in rows:
+                r["error"] = abs(r["value"] / finest["value"] - 1)
+            summary.update(finest_error=None, finest_label=finest["label"], members=rows,
+                           recommendations=[{"target": t, "label": None, "h": None, "wall": None,
+                                             "line": f"for ±{100 * t:g} % {kind['quantity']}: no reference "
+                                                     f"(no usable observed order), no recommendation; the two finest "
+                                                     f"differ by {100 * spread:.2g} %"}
+                                            for t in TARGETS])
+            return summary
+        summary["observed_order"] = rich.order
+        summary["reference"] = rich.value
+        summary["reference_uncertainty"] = rich.uncertainty
+        summary["gci_finest"] = rich.gci
+        for r in rows:
+            r["error"] = abs(r["value"] - rich.value) / abs(rich.value)
+    finest = min(rows, key=lambda r: r["h"])
+    summary["finest_error"] = finest["error"]
+    summary["finest_label"] = finest["label"]
+    summary["recommendations"] = []
+    for target in TARGETS:
+        pick = recommend(rows, target, key_cost="work")
+        if pick is None:
+            line = f"for ±{100 * target:g} % {kind['quantity']}: no member of this family reaches it"
+        else:
+            line = (f"for ±{100 * target:g} % {kind['quantity']}: {pick['label']}, "
+                    f"{pick['wall']:.3g} s on {pick['ranks']} rank(s) ({pick['cpu']:.3g} s CPU; "
+                    f"error {100 * pick['error']:.2g} %)")
+        summary["recommendations"].append({"target": target, "label": pick and pick["label"],
+                                           "h": pick and pick["h"], "wall": pick and pick["wall"],
+                                           "line": line})
+    summary["members"] = rows
+    return summary
+
+
+def write_outputs(kind: dict, rows: list[dict], summary: dict, out: Path) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    stem = out / kind["name"]
+    keys = []
+    for r in rows:
+        keys += [k for k in r if k not in keys]
+    with open(f"{stem}.csv", "w", newline="") as handle:
+        w = csv.DictWriter(handle, fieldnames=keys)
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+    Path(f"{stem}.json").write_text(json.dumps(summary, indent=2, default=_json_default) + "\n")
+    Path(f"{stem}.md").write_text(markdown(kind, rows, summary))
+    plot(kind, rows, summary, Path(f"{stem}.png"))
+
+
+def markdown(kind: dict, rows: list[dict], summary: dict) -> str:
+    """The family as the Markdown table docs/accuracy.md shows, with the summary lines."""
+    also = [k for k in kind.get("also", {}) if all(k in r for r in rows)]
+    lines = [f"| member | {kind['parameter']} ({kind['parameter_unit']}) | value | error | "
+             + "".join(f"{k} | " for k in also) + "increments | work | wall (s) | CPU (s) |",
+             "|---|---|---|---|" + "---|" * len(also) + "---|---|---|---|"]
+    for r in sorted(rows, key=lambda r: -r["h"]):
+        lines.append(f"| {r['label']} | {r['h']:.4g} | {r['value']:.6g} | {100 * r['error']:.3g} % | "
+                     + "".join(f"{r[k]:.5g} | " for k in also)
+                     + f"{r['increments']} | {r['work']:.3g} | {r['wall']:.3g} | {r['cpu']:.3g} |")
+    p = summary["observed_order"]
+    ref = "exact" if summary["reference_kind"] == "exact" else (
+        f"none — {summary['reference_note']}" if summary["reference"] is None else
+        f"Richardson {summary['reference']:.6g} ± {summary['reference_uncertainty']:.2g} "
+        f"(GCI {100 * summary['gci_finest']:.2g} %)")
+    if summary["reference"] is None and summary["reference_kind"] != "exact":
+        lines[0] = lines[0].replace("| error |", "| vs finest |")
+    lines += ["", f"Reference: {ref}. Observed order (three finest): "
+              + ("none" if p is None or p != p else f"{p:.2f}")
+              + ("" if summary.get("monotone", True) else " (the error does not fall: no order)")
+              + f". Total wall time {summary['total_wall']:.0f} s on {rows[0]['ranks']} rank(s).", ""]
+    lines += [f"- {r['line']}" for r in summary["recommendations"]]
+    for key, e in summary.get("also", {}).items():
+        ref = (f"Richardson {e['reference']:.6g} ± {e['uncertainty']:.2g}, finest {100 * e['finest_error']:.2g} % "
+               f"from it" if e["reference"] is not None else f"no reference — {e['note']}")
+        lines.append(f"- also {e['what']} (CSV column `{key}`): {ref}")
+    return "\n".join(lines) + "\n"
+
+
+def _json_default(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return float(x)
+
+
+def plot(kind: dict, rows: list[dict], summary: dict, path: Path) -> None:
+    """Left: error against wall time (targets dashed); right: error against h with the observed
+    order. Without a reference (no usable order) the values themselves are drawn instead."""
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    rows = sorted(rows, key=lambda r: -r["h"])
+    wall = [r["wall"] for r in rows]
+    h = [r["h"] for r in rows]
+    no_ref = summary["reference_kind"] != "exact" and summary["reference"] is None
+    if no_ref:
+        y = [r["value"] for r in rows]
+        ax1.semilogx(wall, y, "o-")
+        ax2.semilogx(h, y, "s-", label="measured")
+        for ax in (ax1, ax2):
+            ax.set_ylabel(kind["quantity"])
+        ax2.set_title(f"{kind['quantity']} against {kind['parameter']}: no usable observed order, "
+                      "no reference", fontsize=9)
+    else:
+        y = [100 * max(r["error"], 1e-12) for r in rows]
+        ax1.loglog(wall, y, "o-")
+        for target in TARGETS:
+            ax1.axhline(100 * target, color="grey", lw=0.6, ls="--")
+        ax2.loglog(h, y, "s-", label="measured")
+        p = summary["observed_order"]
+        if p and math.isfinite(p):
+            ax2.loglog(h, [y[-1] * (x / h[-1]) ** p for x in h], "k:", label=f"observed order {p:.2f}")
+        for ax in (ax1, ax2):
+            ax.set_ylabel("relative error, %")
+        ref = "exact" if kind["reference"] == "exact" else "Richardson-extrapolated"
+        ax2.set_title(f"{kind['quantity']}: error against {kind['parameter']} ({ref} reference)", fontsize=9)
+    for r, w, v in zip(rows, wall, y):
+        ax1.annotate(f"{kind['parameter']} {r['h']:.3g}", (w, v), textcoords="offset points", xytext=(4, 4),
+                     fontsize=8)
+    ax1.set_xlabel(f"wall time per member, s ({rows[0]['ranks']} rank(s); shared machine)")
+    ax1.set_title(f"{kind['name']}: against wall time", fontsize=10)
+    ax2.set_xlabel(f"{kind['parameter']}, {kind['parameter_unit']}")
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""Run `bulkflow-accuracy KIND --quick` against a given solver and check what it wrote.
+
+    check_accuracy.py wave-bar --bulkflow build/bin/bulkflow --workdir /tmp/acc
+
+Checks: KIND.csv, KIND.png and KIND.json exist; the JSON's members are the CSV's rows; the error
+falls strictly with every refinement; the observed order of the three finest is within
+[1.7, 2.6] (both kinds are second order: docs/accuracy.md says why); and every recommendation
+is a member within its target with no member of less work also within it. Exit status 1 with the
+failed checks listed.
+"""
+import argparse
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+ORDER_RANGE = (1.7, 2.6)
+
+
+def main() -> int:
+    p = argparse.ArgumentParser()
+    p.add_argument("kind")
+    p.add_argument("--bulkflow", required=True)
+    p.add_argument("--workdir", required=True, type=Path)
+    a = p.parse_args()
+    out = a.workdir
+    cmd = [sys.executable, "-m", "bulkflow.accuracy.cli", a.kind, "--quick", "--out", str(out),
+           "--solver", a.bulkflow]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    print(proc.stdout + proc.stderr)
+    if proc.returncode != 0:
+        print(f"FAIL: {' '.join(cmd)} exited with {proc.returncode}")
+        return 1
+    failures = []
+
+    def check(ok, what):
+        print(("ok    " if ok else "FAIL  ") + what)
+        if not ok:
+            failures.append(what)
+
+    files = [out / f"{a.kind}.{ext}" for ext in ("csv", "png", "json")]
+    for f in files:
+        check(f.exists() and f.stat().st_size > 0, f"{f} written")
+    if failures:
+        return 1
+    summary = json.loads(files[2].read_text())
+    rows = list(csv.DictReader(files[0].open()))
+    members = summary["members"]
+    check(len(rows) == len(members) >= 4, f"{len(rows)} CSV rows = {len(members)} JSON members (at least 4)")
+    members = sorted(members, key=lambda m: -m["h"])          # coarse to fine
+    errors = [m["error"] for m in members]
+    check(all(e2 < e1 for e1, e2 in zip(errors, errors[1:])),
+          "error falls with every refinement: " + ", ".join(f"h {m['h']:.4g}: {100 * m['error']:.3g} %" for m in members))
+    p_obs = summary["observed_order"]
+    check(p_obs is not None and ORDER_RANGE[0] <= p_obs <= ORDER_RANGE[1],
+          f"observed order {p_obs} within {ORDER_RANGE}")
+    for rec in summary["recommendations"]:
+        target = rec["target"]
+        within = [m for m in members if m["error"] <= target]
+        if not within:
+            check(rec["label"] is None, f"±{100 * target:g} %: no member within it, none recommended")
+            continue
+        best = min(within, key=lambda m: m["work"])
+        check(rec["label"] == best["label"], f"±{100 * target:g} %: recommended '{rec['label']}' is the "
+                                             f"least-work member within it ('{best['label']}')")
+        check(rec["line"].startswith(f"for ±{100 * target:g} %"), f"recommendation line: {rec['line']}")
+    for m in members:
+        check(m["wall"] > 0 and m["cpu"] > 0 and m["increments"] > 0,
+              f"{m['label']}: measured wall {m['wall']:.3g} s, CPU {m['cpu']:.3g} s, {m['increments']} increments")
+    print(f"{len(failures)} check(s) failed" if failures else "all checks passed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
