@@ -73,16 +73,41 @@ contains
     real(dp), intent(in) :: phi(n), sin_phi(n)
     real(dp), intent(out) :: phi_rate(n), sin_phi_rate(n)
     integer :: i, k
-    real(dp) :: f, pressure
+    real(dp) :: a, b, tr, sum2, dgamma(n), pressure(n)
 
+    ! One loop per step with unit stride in the point index (vectorised, as material_update's
+    ! loops); the operations of shear_increment and inertial_fraction.
+    if (ncomp == 4) then
+       do i = 1, n
+          k = k0 + i
+          tr = (strain_inc(k, 1) + strain_inc(k, 2) + strain_inc(k, 3)) / 3.0_dp
+          sum2 = (strain_inc(k, 1) - tr)**2 + (strain_inc(k, 2) - tr)**2 + (strain_inc(k, 3) - tr)**2 &
+               + 2.0_dp * strain_inc(k, 4)**2
+          dgamma(i) = sqrt(2.0_dp * sum2)
+       end do
+    else
+       do i = 1, n
+          k = k0 + i
+          tr = (strain_inc(k, 1) + strain_inc(k, 2) + strain_inc(k, 3)) / 3.0_dp
+          sum2 = (strain_inc(k, 1) - tr)**2 + (strain_inc(k, 2) - tr)**2 + (strain_inc(k, 3) - tr)**2 &
+               + 2.0_dp * (strain_inc(k, 4)**2 + strain_inc(k, 5)**2 + strain_inc(k, 6)**2)
+          dgamma(i) = sqrt(2.0_dp * sum2)
+       end do
+    end if
     do i = 1, n
        k = k0 + i
-       pressure = -(stress_old(k, 1) + stress_old(k, 2) + stress_old(k, 3)) / 3.0_dp
-       f = inertial_fraction(shear_increment(ncomp, strain_inc(k, :)), dt, pressure, i0, d_sqrt_rho)
-       sin_phi_rate(i) = sin_phi(i) + (sin_phi2 - sin_phi(i)) * f
-       ! Where the rate does not move sin φ (f = 0, or below its last bit) φ stays the static
-       ! angle bit for bit (asin(sin φ) need not be φ to the last bit). sin φ2 ≥ sin φ (checked
-       ! by the decoder), so the rate can only raise it.
+       pressure(i) = -(stress_old(k, 1) + stress_old(k, 2) + stress_old(k, 3)) / 3.0_dp
+    end do
+    do i = 1, n
+       a = dgamma(i) * d_sqrt_rho
+       b = i0 * sqrt(max(pressure(i), 0.0_dp)) * max(dt, 0.0_dp)
+       ! a/(a + b), 0 where a = 0 (the denominator then kept away from 0 for the unused branch).
+       sin_phi_rate(i) = sin_phi(i) + (sin_phi2 - sin_phi(i)) * merge(a / max(a + b, tiny(a)), 0.0_dp, a > 0)
+    end do
+    ! Where the rate does not move sin φ (f = 0, or below its last bit) φ stays the static
+    ! angle bit for bit (asin(sin φ) need not be φ to the last bit). sin φ2 ≥ sin φ (checked
+    ! by the decoder), so the rate can only raise it.
+    do i = 1, n
        if (sin_phi_rate(i) > sin_phi(i)) then
           phi_rate(i) = asin(sin_phi_rate(i))
        else
