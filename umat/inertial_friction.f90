@@ -18,7 +18,7 @@ module inertial_friction
   implicit none
   private
 
-  public :: shear_increment, inertial_fraction, mu_of_inertial_number, inertial_friction_chunk
+  public :: shear_increment, inertial_fraction, inertial_friction_chunk
 
 contains
 
@@ -50,17 +50,6 @@ contains
     end if
   end function inertial_fraction
 
-  !> The closed form μ(I) = μs + (μ2 − μs)/(I0/I + 1), μs at I = 0.
-  pure elemental real(dp) function mu_of_inertial_number(mu_s, mu_2, i0, inertial) result(mu)
-    real(dp), intent(in) :: mu_s, mu_2, i0, inertial
-
-    if (inertial > 0) then
-       mu = mu_s + (mu_2 - mu_s) / (i0 / inertial + 1.0_dp)
-    else
-       mu = mu_s
-    end if
-  end function mu_of_inertial_number
-
   !> Rate-dependent sin φ and φ of the points k0+1..k0+n of a VUMAT block, from their static
   !> sin φs (sin_phi, phi: the angle the static model uses) and sin φ2. Where the fraction is
   !> 0 the static values are kept bit for bit (sin φs + 0 = sin φs; φ not recomputed).
@@ -73,10 +62,10 @@ contains
     real(dp), intent(in) :: phi(n), sin_phi(n)
     real(dp), intent(out) :: phi_rate(n), sin_phi_rate(n)
     integer :: i, k
-    real(dp) :: a, b, tr, sum2, dgamma(n), pressure(n)
+    real(dp) :: tr, sum2, dgamma(n), pressure(n)
 
     ! One loop per step with unit stride in the point index (vectorised, as material_update's
-    ! loops); the operations of shear_increment and inertial_fraction.
+    ! loops); the first two are the operations of shear_increment.
     if (ncomp == 4) then
        do i = 1, n
           k = k0 + i
@@ -99,10 +88,8 @@ contains
        pressure(i) = -(stress_old(k, 1) + stress_old(k, 2) + stress_old(k, 3)) / 3.0_dp
     end do
     do i = 1, n
-       a = dgamma(i) * d_sqrt_rho
-       b = i0 * sqrt(max(pressure(i), 0.0_dp)) * max(dt, 0.0_dp)
-       ! a/(a + b), 0 where a = 0 (the denominator then kept away from 0 for the unused branch).
-       sin_phi_rate(i) = sin_phi(i) + (sin_phi2 - sin_phi(i)) * merge(a / max(a + b, tiny(a)), 0.0_dp, a > 0)
+       sin_phi_rate(i) = sin_phi(i) + (sin_phi2 - sin_phi(i)) &
+            * inertial_fraction(dgamma(i), dt, pressure(i), i0, d_sqrt_rho)
     end do
     ! Where the rate does not move sin φ (f = 0, or below its last bit) φ stays the static
     ! angle bit for bit (asin(sin φ) need not be φ to the last bit). sin φ2 ≥ sin φ (checked
