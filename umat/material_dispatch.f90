@@ -26,10 +26,10 @@ contains
   !> One VUMAT call. On failure `ok` is false and `message` says why; the entry point
   !> reports it through the host's error utilities (xplb_abqerr / xplb_exit).
   subroutine material_vumat(nblock, ndir, nshr, nstatev, nfieldv, nprops, lanneal, step_time, &
-       total_time, cmname, props, density, strain_inc, field_new, stress_old, state_old, &
+       total_time, dt, cmname, props, density, strain_inc, field_new, stress_old, state_old, &
        e_int_old, e_inel_old, stress_new, state_new, e_int_new, e_inel_new, ok, message)
     integer, intent(in) :: nblock, ndir, nshr, nstatev, nfieldv, nprops, lanneal
-    real(dp), intent(in) :: step_time, total_time
+    real(dp), intent(in) :: step_time, total_time, dt
     character(len=*), intent(in) :: cmname
     real(dp), intent(in) :: props(nprops), density(nblock)
     real(dp), intent(in) :: strain_inc(nblock, ndir + nshr), field_new(nblock, nfieldv)
@@ -68,7 +68,7 @@ contains
        state_new = state_old
        return
     end if
-    call update_material(choice, nblock, ncomp, nstatev, nfieldv, nprops, props, total_time, density, &
+    call update_material(choice, nblock, ncomp, nstatev, nfieldv, nprops, props, total_time, dt, density, &
          strain_inc, field_new, stress_old, state_old, stress_new, state_new, e_int_old, e_int_new, &
          e_inel_old, e_inel_new)
   end subroutine material_vumat
@@ -101,13 +101,14 @@ contains
     if (.not. ok) message = 'material ' // trim(cmname) // ': ' // trim(message)
   end subroutine decode_material
 
-  !> Stress update of a block of points by the chosen model (not the packaging call).
-  pure subroutine update_material(choice, nblock, ncomp, nstatev, nfieldv, nprops, props, total_time, &
+  !> Stress update of a block of points by the chosen model (not the packaging call); dt is
+  !> the time increment (used by the μ(I) option of Mohr-Coulomb only).
+  pure subroutine update_material(choice, nblock, ncomp, nstatev, nfieldv, nprops, props, total_time, dt, &
        density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, e_int_old, &
        e_int_new, e_inel_old, e_inel_new)
     type(material_choice_t), intent(in) :: choice
     integer, intent(in) :: nblock, ncomp, nstatev, nfieldv, nprops
-    real(dp), intent(in) :: props(nprops), total_time
+    real(dp), intent(in) :: props(nprops), total_time, dt
     real(dp), intent(in) :: density(nblock), strain_inc(nblock, ncomp), field_new(nblock, nfieldv)
     real(dp), intent(in) :: stress_old(nblock, ncomp), state_old(nblock, nstatev)
     real(dp), intent(out) :: stress_new(nblock, ncomp), state_new(nblock, nstatev)
@@ -117,7 +118,7 @@ contains
     select case (choice%model)
     case (model_mohr_coulomb)
        call update_mohr_coulomb_block(nblock, ncomp, nstatev, nfieldv, nprops, props, choice%mc, &
-            total_time, density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, &
+            total_time, dt, density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, &
             e_int_old, e_int_new, e_inel_old, e_inel_new)
     case (model_drucker_prager)
        call update_drucker_prager_block(nblock, ncomp, nstatev, choice%dpp, density, strain_inc, &

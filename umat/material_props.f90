@@ -23,6 +23,9 @@ module material_props
   !> Number of leading scalar props of the Mohr-Coulomb layout (tables follow).
   integer, parameter, public :: mc_n_scalar_props = 16
   integer, parameter, public :: dp_n_props = 6
+  !> Option block appended after the Mohr-Coulomb tables: its kind (1 = μ(I)) and constants.
+  integer, parameter, public :: mc_option_mu_of_i = 1
+  integer, parameter, public :: mc_mu_of_i_n_props = 5   !< kind, φ2 (deg), I0, d, ρs
 
   integer, parameter, public :: message_length = 200
 
@@ -41,6 +44,10 @@ module material_props
      !> Cohesion table rows (c, PEEQ, field) instead of (c, PEEQ): prop 15 < 0.
      logical :: coh_on_field = .false.
      integer :: ang_start = 0, coh_start = 0, ff_start = 0   !< index of the first table value
+     !> Rate-dependent friction μ(I) (inertial_friction, docs/mu_of_i.md): sin φ2 = μ2, I0 and
+     !> d·sqrt(ρs); off unless the option block is there.
+     logical :: mu_of_i = .false.
+     real(dp) :: sin_phi2 = 0, i0 = 0, d_sqrt_rho = 0
   end type mohr_coulomb_props_t
 
   !> Decoded Drucker-Prager constants in Abaqus q-form.
@@ -109,7 +116,7 @@ contains
     type(mohr_coulomb_props_t), intent(out) :: mc
     logical, intent(out) :: ok
     character(len=message_length), intent(out) :: message
-    integer :: needed
+    integer :: needed, extra
 
     call check_elastic(props, nprops, ok, message)
     if (.not. ok) return
@@ -151,9 +158,11 @@ contains
     mc%coh_start = mc%ang_start + 3 * mc%n_ang
     mc%ff_start = mc%coh_start + merge(3, 2, mc%coh_on_field) * mc%n_coh
     needed = mc%ff_start + 2 * mc%n_ff - 1
-    if (nprops /= needed) then
-       write (message, '(a,i0,a,i0)') 'Mohr-Coulomb with these table sizes (props 13, 15, 16) takes exactly ', &
-            needed, ' props, got ', nprops
+    ! Exactly the tables, or the tables and one option block: any other count is an error.
+    extra = nprops - needed
+    if (extra /= 0 .and. extra /= mc_mu_of_i_n_props) then
+       write (message, '(a,i0,a,i0,a,i0)') 'Mohr-Coulomb with these table sizes (props 13, 15, 16) takes ' // &
+            'exactly ', needed, ' props, or ', needed + mc_mu_of_i_n_props, ' with the mu(I) block, got ', nprops
        return
     end if
 
@@ -235,9 +244,51 @@ contains
           return
        end if
     end if
+    if (extra > 0) then
+       call decode_mu_of_i(props(needed + 1:nprops), props(3), props(mc%ang_start:mc%coh_start - 1), &
+            needed + 1, mc, ok, message)
+       if (.not. ok) return
+    end if
     ok = .true.
     message = ''
   end subroutine decode_mohr_coulomb
+
+  !> The μ(I) block (kind, φ2, I0, d, ρs) at props(first...). φ2 must not be below the static
+  !> angle (prop 3, or every φ of the angle table): μ(I) may only raise the friction with rate.
+  pure subroutine decode_mu_of_i(block, phi_deg, angle_rows, first, mc, ok, message)
+    real(dp), intent(in) :: block(mc_mu_of_i_n_props), phi_deg, angle_rows(:)
+    integer, intent(in) :: first
+    type(mohr_coulomb_props_t), intent(inout) :: mc
+    logical, intent(out) :: ok
+    character(len=message_length), intent(out) :: message
+    real(dp) :: phi_static_max
+
+    ok = .false.
+    message = ''
+    ! Exactly the kind (NaN fails too).
+    if (.not. (block(1) >= mc_option_mu_of_i .and. block(1) <= mc_option_mu_of_i)) then
+       write (message, '(a,i0,a,g0.6)') 'option block after the tables: prop ', first, &
+            ' must be 1 (mu(I)), got ', block(1)
+       return
+    end if
+    phi_static_max = phi_deg
+    if (mc%n_ang > 0) phi_static_max = maxval(angle_rows(1::3))
+    if (.not. (block(2) >= phi_static_max .and. block(2) <= 89.0_dp)) then
+       write (message, '(a,i0,a)') 'mu(I): phi2 (prop ', first + 1, &
+            ') must lie between the static friction angle (largest of the table) and 89 degrees'
+       return
+    end if
+    if (.not. (block(3) > 0 .and. block(4) > 0 .and. block(5) > 0)) then
+       write (message, '(a,i0,a,i0,a)') 'mu(I): I0, d and rho_s (props ', first + 2, '-', first + 4, &
+            ') must be positive'
+       return
+    end if
+    mc%mu_of_i = .true.
+    mc%sin_phi2 = sin(block(2) * deg_to_rad)
+    mc%i0 = block(3)
+    mc%d_sqrt_rho = block(4) * sqrt(block(5))
+    ok = .true.
+  end subroutine decode_mu_of_i
 
   pure subroutine decode_drucker_prager(props, nprops, nstatev, dpp, ok, message)
     integer, intent(in) :: nprops, nstatev

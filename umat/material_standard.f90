@@ -35,13 +35,14 @@ module material_standard
 
 contains
 
-  !> One UMAT call. time_end: total time at the end of the increment (TIME(2) + DTIME);
+  !> One UMAT call. time_end: total time at the end of the increment (TIME(2) + DTIME), dtime
+  !> the time increment (the μ(I) option's rate);
   !> stress, statev, sse, spd: start-of-increment values in, end values out. On failure `ok`
   !> is false and `message` says why (the entry point stops the analysis with it).
-  subroutine material_umat(ndi, nshr, ntens, nstatv, nprops, time_end, cmname, props, &
+  subroutine material_umat(ndi, nshr, ntens, nstatv, nprops, time_end, dtime, cmname, props, &
        dstran, stress, statev, sse, spd, ddsdde, ok, message)
     integer, intent(in) :: ndi, nshr, ntens, nstatv, nprops
-    real(dp), intent(in) :: time_end
+    real(dp), intent(in) :: time_end, dtime
     character(len=*), intent(in) :: cmname
     real(dp), intent(in) :: props(nprops), dstran(ntens)
     real(dp), intent(inout) :: stress(ntens), statev(nstatv), sse, spd
@@ -82,7 +83,7 @@ contains
     one = 1
     e_inel_old = spd
     e_int_old = sse + spd
-    call update_material(choice, 1, ntens, nstatv, 1, nprops, props, time_end, one, strain_inc, field, &
+    call update_material(choice, 1, ntens, nstatv, 1, nprops, props, time_end, dtime, one, strain_inc, field, &
          stress_old, state_old, stress_new, state_new, e_int_old, e_int_new, e_inel_old, e_inel_new)
     do i = 1, ntens
        stress(i) = stress_new(1, explicit_slot(i))
@@ -119,7 +120,9 @@ contains
        phi = choice%mc%phi
        psi = choice%mc%psi
        cohesion = state_new(sdv_cohesion)
-       if (choice%mc%n_ang > 0) then
+       ! The angle the update used: from the table, or raised by μ(I) (its tangent holds φ
+       ! fixed, the rate term is not differentiated).
+       if (choice%mc%n_ang > 0 .or. choice%mc%mu_of_i) then
           phi = state_new(sdv_phi) * deg_to_rad
           psi = state_new(sdv_psi) * deg_to_rad
        end if

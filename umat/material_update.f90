@@ -19,6 +19,7 @@ module material_update
        rebuild_plane_block, principal_3d_block, rebuild_3d_block
   use mohr_coulomb_return, only: mohr_coulomb_return_block
   use drucker_prager_return, only: drucker_prager_stress_return
+  use inertial_friction, only: inertial_friction_chunk
   use property_table, only: interpolate_table, interpolate_table_field
   use flow_function, only: flow_function_none, unconfined_yield_strength, &
        cohesion_from_unconfined_strength
@@ -63,13 +64,16 @@ contains
   !> state and energy bookkeeping. Only the strength parameters from tables (angles, flow
   !> function, hardening) are evaluated point by point. The chunk's work arrays have a fixed
   !> size (no allocation) and stay in the L1 cache.
+  !> With the μ(I) option (mc%mu_of_i) the friction angle of each point is raised with the
+  !> inertial number of this increment (strain_inc/dt, start-of-increment pressure) before the
+  !> return; without it dt is not used and the update is the static one.
   pure subroutine update_mohr_coulomb_block(nblock, ncomp, nstatev, nfieldv, nprops, props, mc, &
-       total_time, density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, &
+       total_time, dt, density, strain_inc, field_new, stress_old, state_old, stress_new, state_new, &
        e_int_old, e_int_new, e_inel_old, e_inel_new)
     integer, intent(in) :: nblock, ncomp, nstatev, nfieldv, nprops
     real(dp), intent(in) :: props(nprops)
     type(mohr_coulomb_props_t), intent(in) :: mc
-    real(dp), intent(in) :: total_time
+    real(dp), intent(in) :: total_time, dt
     real(dp), intent(in) :: density(nblock), strain_inc(nblock, ncomp), field_new(nblock, nfieldv)
     real(dp), intent(in) :: stress_old(nblock, ncomp), state_old(nblock, nstatev)
     real(dp), intent(out) :: stress_new(nblock, ncomp), state_new(nblock, nstatev)
@@ -81,6 +85,7 @@ contains
     real(dp) :: c2(block_points), s2(block_points)
     real(dp) :: phi(block_points), psi(block_points), sin_phi(block_points), sin_psi(block_points)
     real(dp) :: cohesion(block_points)
+    real(dp) :: phi_rate(block_points), sin_phi_rate(block_points)   ! μ(I) option only
     integer :: izz(block_points), region(block_points)
     integer :: k0, n, i, j, k, ang_end, coh_end, ff_end
     real(dp) :: lam, two_g, lam_tr, vol_factor, fc, x, d1, d2, d3, dp1, dp2, dp3, trace, third_trace
@@ -164,8 +169,16 @@ contains
        else
           call principal_3d_block(n, s_trial, sig_trial, vec)
        end if
-       call mohr_coulomb_return_block(n, sig_trial, sin_phi, sin_psi, cohesion, lam, mc%shear, &
-            mc%tension_cutoff, mc%sigma_t, sig, region)
+       if (mc%mu_of_i) then
+          ! Rate-dependent angle; the cohesion above keeps the static φ (a material property).
+          call inertial_friction_chunk(n, k0, nblock, ncomp, strain_inc, stress_old, dt, mc%sin_phi2, &
+               mc%i0, mc%d_sqrt_rho, phi, sin_phi, phi_rate, sin_phi_rate)
+          call mohr_coulomb_return_block(n, sig_trial, sin_phi_rate, sin_psi, cohesion, lam, mc%shear, &
+               mc%tension_cutoff, mc%sigma_t, sig, region)
+       else
+          call mohr_coulomb_return_block(n, sig_trial, sin_phi, sin_psi, cohesion, lam, mc%shear, &
+               mc%tension_cutoff, mc%sigma_t, sig, region)
+       end if
        if (ncomp == 4) then
           call rebuild_plane_block(n, sig, c2, s2, izz, s_back)
        else
@@ -211,6 +224,7 @@ contains
           state_new(k0 + i, sdv_phi) = phi(i) * rad_to_deg
           state_new(k0 + i, sdv_psi) = psi(i) * rad_to_deg
        end do
+       if (mc%mu_of_i) state_new(k0 + 1:k0 + n, sdv_phi) = phi_rate(1:n) * rad_to_deg
 
        ! Internal energy: ½(σ_old + σ_new):Δε, tensor shears counted twice (stress_power).
        if (ncomp == 4) then

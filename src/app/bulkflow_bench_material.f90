@@ -4,7 +4,7 @@
 !> decoding, elastic trial, principal decomposition, return, rebuild, state and energies).
 !> The points are prepared so that every update is plastic, over a mix of return regions.
 !> Usage: bulkflow-bench-material [model] [seconds per case]
-!>   model: MC (default), MC-TABLE (angle table + flow function), DP, ELASTIC
+!>   model: MC (default), MC-MUI (MC with mu(I)), MC-TABLE (angle table + flow function), DP, ELASTIC
 program bulkflow_bench_material
   use, intrinsic :: iso_fortran_env, only: int64, output_unit
   use base_kinds, only: dp
@@ -33,6 +33,11 @@ program bulkflow_bench_material
      cmname = 'MC-BENCH'
      props = [10.0e6_dp, 0.3_dp, 30.0_dp, 10.0_dp, 5.0e3_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
           0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp]
+  case ('MC-MUI')
+     ! MC with the rate-dependent friction mu(I) (docs/mu_of_i.md): phi2 45, I0 0.279, d 0.5 mm.
+     cmname = 'MC-BENCH'
+     props = [10.0e6_dp, 0.3_dp, 30.0_dp, 10.0_dp, 5.0e3_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, &
+          0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 45.0_dp, 0.279_dp, 0.5e-3_dp, 2450.0_dp]
   case ('MC-TABLE')
      cmname = 'MC-BENCH'
      props = [10.0e6_dp, 0.3_dp, 30.0_dp, 10.0_dp, 5.0e3_dp, 0.0_dp, 0.0_dp, 1.0_dp, 2.0e3_dp, 0.3_dp, &
@@ -44,7 +49,7 @@ program bulkflow_bench_material
      cmname = 'ELASTIC-BENCH'
      props = [10.0e6_dp, 0.3_dp]
   case default
-     write (output_unit, '(a)') 'usage: bulkflow-bench-material [MC|MC-TABLE|DP|ELASTIC] [seconds per case]'
+     write (output_unit, '(a)') 'usage: bulkflow-bench-material [MC|MC-MUI|MC-TABLE|DP|ELASTIC] [seconds per case]'
      error stop 2
   end select
 

@@ -73,7 +73,7 @@ contains
     select case (name)
     case ('DENSITY', 'ELASTIC', 'MOHR COULOMB', 'MOHR COULOMB HARDENING', 'TENSION CUTOFF', &
          'DRUCKER PRAGER', 'DRUCKER PRAGER HARDENING', 'USER MATERIAL', 'DEPVAR', &
-         'USER DEFINED FIELD', 'FLOW FUNCTION')
+         'USER DEFINED FIELD', 'FLOW FUNCTION', 'INERTIAL FRICTION')
        is_material_option = .true.
     case default
        is_material_option = .false.

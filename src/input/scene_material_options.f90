@@ -20,8 +20,8 @@ module scene_material_options
   integer, parameter, public :: opt_density = 1, opt_elastic = 2, opt_mohr_coulomb = 3, &
        opt_mc_hardening = 4, opt_tension_cutoff = 5, opt_drucker_prager = 6, &
        opt_dp_hardening = 7, opt_user_material = 8, opt_depvar = 9, opt_user_field = 10, &
-       opt_flow_function = 11
-  integer, parameter, public :: n_material_options = 11
+       opt_flow_function = 11, opt_inertial_friction = 12
+  integer, parameter, public :: n_material_options = 12
 
   integer, parameter, public :: dp_hardening_compression = 1, dp_hardening_shear = 2, &
        dp_hardening_tension = 3
@@ -51,6 +51,8 @@ module scene_material_options
      real(dp) :: fc0 = 0, slope = 0, t_freeze = 0
      logical :: record_maximum = .false.
      real(dp), allocatable :: flow_table(:, :)    !< (2, n): sigma1, fc
+     !> our *INERTIAL FRICTION: phi2 (deg), I0, d, rho_s of the mu(I) block (docs/mu_of_i.md)
+     real(dp) :: inertial(4) = 0
   end type material_input_t
 
 contains
@@ -76,6 +78,7 @@ contains
     case ('USER MATERIAL'); opt = opt_user_material
     case ('DEPVAR'); opt = opt_depvar
     case ('USER DEFINED FIELD'); opt = opt_user_field
+    case ('INERTIAL FRICTION'); opt = opt_inertial_friction
     case default; opt = opt_flow_function
     end select
     if (mat%option_block(opt) /= 0) then
@@ -105,6 +108,8 @@ contains
        call read_user_material(blk, mat, err)
     case (opt_depvar)
        call read_depvar(blk, mat, err)
+    case (opt_inertial_friction)
+       call read_inertial_friction(blk, mat, err)
     case (opt_user_field)
        ! FIELDS=n as bulkflow-matpoint takes it: the nfieldv a VUSDFLD writes (a user's VUSDFLD
        ! may write more than field 1; the host's arrays must have that many columns).
@@ -306,6 +311,24 @@ contains
        end associate
     end do
   end subroutine read_mc_hardening
+
+  !> Our *INERTIAL FRICTION: one line phi2 (deg), I0, d, rho_s, the mu(I) block of the MC VUMAT
+  !> (umat/README.md); the VUMAT's decoder checks the values against the static angles.
+  subroutine read_inertial_friction(blk, mat, err)
+    type(keyword_block_t), intent(in) :: blk
+    type(material_input_t), intent(inout) :: mat
+    type(error_t), intent(inout) :: err
+    integer :: i
+
+    call blk%check_params([character(len=8) ::], err)
+    if (err%raised) return
+    call one_line(blk, 4, 4, 'phi2 (deg), I0, d, rho_s', err)
+    if (err%raised) return
+    do i = 1, 4
+       call get_real(blk%lines(1), i, mat%inertial(i), err)
+       if (err%raised) return
+    end do
+  end subroutine read_inertial_friction
 
   subroutine read_tension_cutoff(blk, mat, err)
     type(keyword_block_t), intent(in) :: blk

@@ -19,6 +19,7 @@ module scene_materials
   use scene_layout, only: scene_layout_t, is_material_option
   use scene_material_options, only: material_input_t, read_material_option, opt_density, &
        opt_elastic, opt_mohr_coulomb, opt_mc_hardening, opt_tension_cutoff, opt_drucker_prager, &
+       opt_inertial_friction, &
        opt_dp_hardening, opt_user_material, opt_depvar, opt_user_field, opt_flow_function, &
        dp_hardening_shear, dp_hardening_tension
   use scene_util, only: rtoa, itoa, where_text, expect_lines, check_name
@@ -281,6 +282,11 @@ contains
                  'material ' // nm // '; expected it with *MOHR COULOMB', err)
             return
          end if
+         if (ob(opt_inertial_friction) /= 0) then
+            call deck%blocks(ob(opt_inertial_friction))%fail('*INERTIAL FRICTION without *MOHR ' // &
+                 'COULOMB in material ' // nm // '; expected it with *MOHR COULOMB', err)
+            return
+         end if
       else if (ob(opt_mc_hardening) == 0 .and. ob(opt_flow_function) == 0) then
          call deck%blocks(ob(opt_mohr_coulomb))%fail('material ' // nm // ' has *MOHR COULOMB ' // &
               'but no cohesion; expected *MOHR COULOMB HARDENING or *FLOW FUNCTION', err)
@@ -355,7 +361,9 @@ contains
     on_field = n_coh > 0 .and. coh_columns == 3
     n_ff = 0
     if (allocated(mat%flow_table)) n_ff = size(mat%flow_table, 2)
-    allocate (p(mc_n_scalar_props + 3 * n_ang + coh_columns * n_coh + 2 * n_ff))
+    ! + the mu(I) block (kind 1, phi2, I0, d, rho_s) with our *INERTIAL FRICTION
+    allocate (p(mc_n_scalar_props + 3 * n_ang + coh_columns * n_coh + 2 * n_ff &
+         + merge(5, 0, mat%option_block(opt_inertial_friction) /= 0)))
     p = 0
     p(1) = mat%young
     p(2) = mat%poisson
@@ -381,6 +389,8 @@ contains
     if (n_coh > 0) p(k + 1:k + coh_columns * n_coh) = reshape(mat%cohesion, [coh_columns * n_coh])
     k = k + coh_columns * n_coh
     if (n_ff > 0) p(k + 1:k + 2 * n_ff) = reshape(mat%flow_table, [2 * n_ff])
+    k = k + 2 * n_ff
+    if (mat%option_block(opt_inertial_friction) /= 0) p(k + 1:k + 5) = [1.0_dp, mat%inertial]
     m%vumat_name = 'MC-' // trim(mat%name)
     call move_alloc(p, m%props)
     call model_state_first(m)

@@ -42,9 +42,9 @@ module matpoint_input
 
   public :: build_matpoint_input, read_matpoint_file, read_matpoint_string
 
-  character(len=24), parameter :: known_keywords(20) = [character(len=24) :: &
+  character(len=24), parameter :: known_keywords(21) = [character(len=24) :: &
        'HEADING', 'MATERIAL', 'DENSITY', 'ELASTIC', 'MOHR COULOMB', 'MOHR COULOMB HARDENING', &
-       'TENSION CUTOFF', 'FLOW FUNCTION', 'DRUCKER PRAGER', 'DRUCKER PRAGER HARDENING', &
+       'TENSION CUTOFF', 'FLOW FUNCTION', 'INERTIAL FRICTION', 'DRUCKER PRAGER', 'DRUCKER PRAGER HARDENING', &
        'USER MATERIAL', 'DEPVAR', 'USER DEFINED FIELD', 'INITIAL CONDITIONS', 'TEST', 'STAGE', &
        'DRIVER CONTROLS', 'AMPLITUDE', 'TEMPERATURE', 'INCLUDE']
 

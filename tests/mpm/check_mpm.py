@@ -20,6 +20,10 @@ kinds:
              no particle is put back onto the plane (GUARDED = 0): src/mpm/mpm_mirror.f90
   mass       hopper with outlet, outflow and inflow: initial + in - out = in domain exactly
              (particle counts exact, masses to round-off), and both flows present
+  mass_mu_of_i  the mass checks on a hopper whose MC material has the mu(I) block
+             (docs/mu_of_i.md), and every frame's S, V, SDV finite; the friction angle used (SDV7)
+             between the static angle (prop 3) and phi2 everywhere, and above the static angle
+             somewhere in the discharge (the rate acted)
   plate      a rigid plate (a *SURFACE, TYPE=SEGMENTS on a *RIGID BODY node moved by *BOUNDARY) pushed
              into an elastic column in a frictionless box (plate_oedometer_2d.inp): its reaction
              against the oedometric force balance F = M W |ln(1 - u/H)|, M = E(1-nu)/((1+nu)(1-2nu)),
@@ -218,6 +222,27 @@ def mass(args):
     integral = np.sum(hist["MDR"][1:] * dt)
     check(abs(integral - hist["MASS_OUT"][-1]) <= 1e-9 * hist["MASS"][0],
           f"integral of MDR = {integral:.6g} kg = MASS_OUT")
+
+
+def mass_mu_of_i(args):
+    mass(args)
+    base = args.workdir / Path(args.scene).stem
+    text = Path(args.scene).read_text()
+    block = re.search(r"\*USER MATERIAL, CONSTANTS=(\d+)\n((?:[^*].*\n)+)", text)
+    props = [float(v) for v in block.group(2).replace("\n", ",").split(",") if v.strip()]
+    check(len(props) == int(block.group(1)) and props[-5] == 1, "the material has the mu(I) block")
+    phi_s, phi2 = props[2], props[-4]
+    f = h5py.File(str(base) + ".h5", "r")
+    frames = sorted(f["particles"])
+    raised = 0.0
+    for k in frames[1:]:
+        g = f["particles"][k]
+        check(all(np.isfinite(g[name][()]).all() for name in ("S", "V", "SDV")), f"frame {k}: S, V, SDV finite")
+        phi = g["SDV"][()][:, 6]
+        check(phi.min() >= phi_s - 1e-9 and phi.max() <= phi2 + 1e-9,
+              f"frame {k}: PHI in [{phi_s}, {phi2}] (got {phi.min():.6f} .. {phi.max():.6f})")
+        raised = max(raised, float(np.median(phi)) - phi_s)
+    check(raised > 0, f"the rate raised the median friction angle (by {raised:.3g} deg at most)")
 
 
 def mirror(args):
@@ -568,7 +593,7 @@ def sort(args):
 
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("kind", choices=["column", "incline", "heap", "mirror", "mass", "mpi", "restart", "plate", "bowl",
+    p.add_argument("kind", choices=["column", "incline", "heap", "mirror", "mass", "mass_mu_of_i", "mpi", "restart", "plate", "bowl",
                                        "sort"])
     p.add_argument("--mpiexec", default="mpirun")
     p.add_argument("--ranks", type=int, default=1, help="restart: number of ranks")

@@ -27,7 +27,7 @@ subroutine umat(stress, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpl
   ddsddt = 0
   drplde = 0
   drpldt = 0
-  call material_umat(ndi, nshr, ntens, nstatv, nprops, time(2) + dtime, cmname, props, dstran, &
+  call material_umat(ndi, nshr, ntens, nstatv, nprops, time(2) + dtime, dtime, cmname, props, dstran, &
        stress, statev, sse, spd, ddsdde, ok, message)
   if (.not. ok) then
      intv = 0

@@ -31,7 +31,7 @@ subroutine vumat(nblock, ndir, nshr, nstatev, nfieldv, nprops, lanneal, &
   character(len=8) :: charv(1)
 
   call material_vumat(nblock, ndir, nshr, nstatev, nfieldv, nprops, lanneal, stepTime, totalTime, &
-       cmname, props, density, strainInc, fieldNew, stressOld, stateOld, enerInternOld, enerInelasOld, &
+       dt, cmname, props, density, strainInc, fieldNew, stressOld, stateOld, enerInternOld, enerInelasOld, &
        stressNew, stateNew, enerInternNew, enerInelasNew, ok, message)
   if (.not. ok) then
      intv = 0
