@@ -3,6 +3,7 @@
     bulkflow-arching-study height      [--quick]   # COW vs material height, Case A and B (Fig. 6.2, 6.8), + Enstad arch
     bulkflow-arching-study parametric  [--quick]   # θ, φw, φ, k around Case A at 2 m (Fig. 6.9)
     bulkflow-arching-study mesh        [--quick]   # elements along the outlet vs COW and wall time (Fig. 6.4)
+    bulkflow-arching-study convergence [--n-arcs 16,30,60]  # COW vs mesh, physical vs half-element FLOW rule
     bulkflow-arching-study elastic     [--quick]   # E and ν (Fig. 6.6)
     bulkflow-arching-study stress      [--quick]   # principal stresses along the wall vs Enstad (Fig. 6.7)
     bulkflow-arching-study powders     [--quick]   # Eckhoff & Leversen powders, both c0 readings, linear/bilinear (Table 6.3)
@@ -27,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .cow import find_cow, table, theory_estimates
+from .cow import Search, find_cow, refine, table, theory_estimates
 from .runner import run_scene
-from .scene import ArchingScene, enstad_beta, scene_from_case
+from .scene import CRITERIA, ArchingScene, enstad_beta, scene_from_case
 
 
 def _settings(quick: bool) -> dict:
@@ -368,8 +369,99 @@ def study_stress(a) -> Study:
     return st
 
 
+def study_convergence(a) -> Study:
+    """The COW on refined meshes under each FLOW criterion (issue 21): Case B (1 m unless --height)
+    and the polymer (fc0 reading, 1 m). Per case and criterion one search runs from the coarsest
+    mesh up: bracket and bisect on the first mesh, then on each finer mesh check the previous
+    interval widened by --margin on both sides (widened further while it does not bracket) and
+    bisect to 2 mm. One CSV row per (case, criterion, mesh): the interval, the runs on that mesh
+    and their wall time."""
+    st = Study("convergence", a.out, a.np)
+    ns = [int(v) for v in a.n_arcs.split(",")]
+    crits = a.criteria.split(",") if a.criteria else list(CRITERIA)
+    cases = [c for c in (("B", "c0", a.height or 1.0), ("polymer", "fc0", 1.0)) if c[0] in a.cases.split(",")]
+    rows = []
+    for case, reading, h in cases:
+        for crit in crits:
+            sc = scene_from_case(case, reading, height=h, n_arc=ns[0], criterion=crit, field_frames=0)
+            tag = f"{case}_{reading}_{crit}"
+            srch = Search(sc, a.out / "runs" / tag, a.np, lambda m: print(m, flush=True))
+            est = theory_estimates(sc)
+            start = next((est[k] for k in ("enstad", "jenike", "mclean") if est[k] and math.isfinite(est[k])), 0.2)
+            lo = hi = None
+            for n in ns:
+                print(f"convergence: case {case} ({reading}), criterion {crit}, n_arc {n}", flush=True)
+                k0 = len(srch.runs)
+                if lo is not None and hi is not None:
+                    lo, hi = lo - a.margin, hi + a.margin
+                    lo, hi = refine(srch, lo, hi, n, 0.002, 0.5 * (lo + hi))
+                else:
+                    lo, hi = srch.bracket(min(start, 0.9 * srch.max_width()), n)
+                    if lo is not None and hi is not None:
+                        lo, hi = srch.bisect(lo, hi, n, 0.002)
+                runs = srch.runs[k0:]
+                walls = [r.wall for r in runs]
+                rows.append(dict(case=case, reading=reading, height=h, criterion=crit, n_arc=n,
+                                 n_elements=replace(sc, n_arc=n, outlet_width=lo or hi or start).n_elements(),
+                                 fem_no_flow=lo, fem_flow=hi, runs=len(runs), wall=sum(walls),
+                                 wall_per_run=sum(walls) / max(len(walls), 1), wall_max=max(walls, default=0.0),
+                                 enstad=est["enstad"]))
+                r = rows[-1]
+                print(f"  -> {_cm(lo):.2f} .. {_cm(hi):.2f} cm, {len(runs)} runs, {r['wall']:.0f} s "
+                      f"({r['wall_per_run']:.1f} s per run)", flush=True)
+                _save_convergence(a.out, rows)
+            st.results.append(dict(case=case, reading=reading, criterion=crit,
+                                   runs=[x.as_dict() for x in srch.runs]))
+    _save_convergence(a.out, rows)
+    (a.out / "convergence.json").write_text(json.dumps(dict(rows=rows, searches=st.results), default=str))
+    plt = _plt()
+    fig, axs = plt.subplots(1, len(cases), figsize=(5 * len(cases), 4), squeeze=False)
+    for ax, (case, reading, h) in zip(axs[0], cases):
+        for crit, c in zip(crits, ("tab:blue", "tab:red")):
+            rr = [r for r in rows if r["case"] == case and r["criterion"] == crit and r["fem_no_flow"]
+                  and r["fem_flow"]]
+            x = [r["n_arc"] for r in rr]
+            ax.fill_between(x, [_cm(r["fem_no_flow"]) for r in rr], [_cm(r["fem_flow"]) for r in rr],
+                            color=c, alpha=0.4)
+            ax.plot(x, [0.5 * (_cm(r["fem_no_flow"]) + _cm(r["fem_flow"])) for r in rr], "o-", color=c, label=crit)
+        ax.set_xscale("log")
+        ax.set_xlabel("elements along the outlet arc")
+        ax.set_ylabel("critical outlet width (cm)")
+        ax.set_title(f"{case} ({reading}), H = {h:g} m")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(a.out / "convergence.png", dpi=120)
+    print(convergence_table(rows))
+    return st
+
+
+def _save_convergence(out: Path, rows: list[dict]) -> None:
+    with open(out / "convergence.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    (out / "convergence_table.txt").write_text(convergence_table(rows) + "\n")
+
+
+def convergence_table(rows: list[dict]) -> str:
+    """Markdown table: per case and mesh, the interval under each criterion and its cost."""
+    lines = ["| case | n_arc | criterion | COW no flow .. flow (cm) | shift from the previous mesh (mm) | runs | wall (s) | wall per run (s) |",
+             "|---|---|---|---|---|---|---|---|"]
+    prev = {}
+    for r in rows:
+        key = (r["case"], r["criterion"])
+        mid = (0.5 * (r["fem_no_flow"] + r["fem_flow"]) if r["fem_no_flow"] and r["fem_flow"] else None)
+        shift = f"{(mid - prev[key]) * 1000:+.1f}" if mid is not None and prev.get(key) is not None else "—"
+        prev[key] = mid
+        lines.append(f"| {r['case']} ({r['reading']}, {r['height']:g} m) | {r['n_arc']} | {r['criterion']} | "
+                     f"{_cm(r['fem_no_flow']):.2f} .. {_cm(r['fem_flow']):.2f} | {shift} | {r['runs']} | "
+                     f"{r['wall']:.0f} | {r['wall_per_run']:.1f} |")
+    return "\n".join(lines)
+
+
 STUDIES = dict(height=study_height, parametric=study_parametric, mesh=study_mesh, elastic=study_elastic,
-               stress=study_stress, powders=study_powders, benchmark=study_benchmark, cost=study_cost)
+               stress=study_stress, powders=study_powders, benchmark=study_benchmark, cost=study_cost,
+               convergence=study_convergence)
 
 
 def main(argv=None) -> int:
@@ -383,6 +475,11 @@ def main(argv=None) -> int:
     p.add_argument("--width", type=float, default=None, help="stress: the outlet width (m)")
     p.add_argument("--bracket", default="", help="cost: lo,hi (m) to skip the coarse bracket")
     p.add_argument("--t-open", type=float, default=0.5, help="cost: the opening step without early stop (s)")
+    p.add_argument("--n-arcs", default="16,30,60", help="convergence: the meshes, coarsest first")
+    p.add_argument("--criteria", default="", help="convergence: FLOW criteria (default: physical,half-element)")
+    p.add_argument("--cases", default="B,polymer", help="convergence: B and/or polymer")
+    p.add_argument("--margin", type=float, default=0.004,
+                   help="convergence: the previous mesh's interval widened by this on both sides (m)")
     p.add_argument("--quick-skip-enstad", action="store_true", help="height: skip the Enstad-arch variant")
     a = p.parse_args(argv)
     a.out = Path(a.out or f"out/arching/{a.study}")
