@@ -33,6 +33,16 @@ from .runner import run_scene
 from .scene import CRITERIA, ArchingScene, enstad_beta, scene_from_case
 
 
+#: FLOW criterion of every study but `convergence` (None: the scene generator's default); --criterion
+CRITERION: str | None = None
+
+
+def case_scene(case: str, reading: str = "c0", **kw) -> ArchingScene:
+    if CRITERION is not None:
+        kw.setdefault("criterion", CRITERION)
+    return scene_from_case(case, reading, **kw)
+
+
 def _settings(quick: bool) -> dict:
     return dict(n_arc=16, tol=0.004, coarse_n_arc=8) if quick else dict(n_arc=30, tol=0.002, coarse_n_arc=12)
 
@@ -110,12 +120,12 @@ def study_height(a) -> Study:
     heights = [1.0, 2.0, 3.0]
     for case in ("A", "B"):
         for h in heights:
-            sc = scene_from_case(case, "c0", height=h, n_arc=s["n_arc"])
+            sc = case_scene(case, "c0", height=h, n_arc=s["n_arc"])
             st.point(sc, case=case, reading="c0", variable="height", value=h, tol=s["tol"],
                      coarse_n_arc=s["coarse_n_arc"])
         if case == "A" and not a.quick_skip_enstad:
             for h in ([2.0] if a.quick else heights):
-                d = scene_from_case(case, "c0", height=h)
+                d = case_scene(case, "c0", height=h)
                 beta = enstad_beta(dict(rho=d.density, phi=d.phi, phi_w=d.phi_w, k=d.k, fc0=d.fc0, theta=d.theta,
                                         height=h))
                 sc = replace(d, arch="enstad", beta=beta, n_arc=s["n_arc"])
@@ -126,7 +136,7 @@ def study_height(a) -> Study:
     for ax, case in zip(axes, ("A", "B")):
         rows = [r for r in st.rows if r["case"] == case and r["variable"] == "height"]
         hs = np.linspace(0.6, 3.2, 27)
-        th = [theory_estimates(scene_from_case(case, "c0", height=h)) for h in hs]
+        th = [theory_estimates(case_scene(case, "c0", height=h)) for h in hs]
         for key, c in (("jenike", "g"), ("enstad", "r"), ("mclean", "k")):
             ax.plot(hs, [_cm(t[key]) for t in th], "-", color=c, lw=1, label=key.capitalize())
         _plot_points(ax, rows, label="FEM, arch centred at the apex")
@@ -149,7 +159,7 @@ def study_parametric(a) -> Study:
               "k": [0.0, 0.2, 0.4]}
     if a.quick:
         sweeps = {k: [v[0], v[-1]] for k, v in sweeps.items()}
-    base = scene_from_case("A", "c0", height=2.0, n_arc=s["n_arc"])
+    base = case_scene("A", "c0", height=2.0, n_arc=s["n_arc"])
     from .scene import fc0_from_c0
     for var, values in sweeps.items():
         for v in values:
@@ -178,7 +188,7 @@ def study_mesh(a) -> Study:
     ns = [10, 20, 30] if a.quick else [10, 20, 30, 60]
     h = a.height or 1.0
     for n in ns:
-        sc = scene_from_case("B", "c0", height=h, n_arc=n)
+        sc = case_scene("B", "c0", height=h, n_arc=n)
         st.point(sc, case="B", reading="c0", variable="n_arc", value=n, tol=0.002,
                  coarse_n_arc=10 if n > 10 else 0)
     plt = _plt()
@@ -199,7 +209,7 @@ def study_mesh(a) -> Study:
 def study_elastic(a) -> Study:
     st = Study("elastic", a.out, a.np)
     s = _settings(a.quick)
-    base = scene_from_case("A", "c0", height=2.0, n_arc=s["n_arc"])
+    base = case_scene("A", "c0", height=2.0, n_arc=s["n_arc"])
     sweeps = {"young": [5e6, 10e6, 40e6], "poisson": [0.1, 0.2, 0.3]}
     if a.quick:
         sweeps = {k: [v[0], v[-1]] for k, v in sweeps.items()}
@@ -227,7 +237,7 @@ def study_powders(a) -> Study:
         for reading in ("c0", "fc0"):
             for flow in (("linear",) if case == "polymer" else ("linear", "bilinear")):
                 h = a.height or (3.0 if (case == "polymer" and reading == "c0") else 1.0)
-                sc = scene_from_case(case, reading, height=h, n_arc=s["n_arc"], flow=flow)
+                sc = case_scene(case, reading, height=h, n_arc=s["n_arc"], flow=flow)
                 st.point(sc, case=case, reading=reading, variable="flow", value=flow, tol=s["tol"],
                          coarse_n_arc=s["coarse_n_arc"])
     with open(a.out / "powders_table.txt", "w") as f:
@@ -249,7 +259,7 @@ def study_benchmark(a) -> Study:
     st = Study("benchmark", a.out, a.np)
     for reading in ("fc0", "c0"):
         h = a.height or (3.0 if reading == "c0" else 1.0)
-        sc = scene_from_case("polymer", reading, height=h, n_arc=30)
+        sc = case_scene("polymer", reading, height=h, n_arc=30)
         t0 = time.perf_counter()
         st.point(sc, case="polymer", reading=reading, variable="benchmark", value=h, tol=0.002, coarse_n_arc=12)
         print(f"polymer, reading {reading}, H = {h} m: search wall time {time.perf_counter() - t0:.1f} s", flush=True)
@@ -278,7 +288,7 @@ def study_cost(a) -> Study:
     rows = []
     for name, kw in variants:
         for w in ends:
-            sc = scene_from_case("B", "c0", height=h, n_arc=s["n_arc"], outlet_width=w, field_frames=0, **kw)
+            sc = case_scene("B", "c0", height=h, n_arc=s["n_arc"], outlet_width=w, field_frames=0, **kw)
             tag = name.replace(" ", "_")
             try:
                 rec = run_scene(sc, a.out / "runs" / tag, np=a.np, log=print)
@@ -318,7 +328,7 @@ def study_stress(a) -> Study:
     h = a.height or 2.0
     n = 16 if a.quick else 30
     width = a.width or 0.26
-    sc = scene_from_case("B", "c0", height=h, n_arc=n, outlet_width=width, field_frames=20)
+    sc = case_scene("B", "c0", height=h, n_arc=n, outlet_width=width, field_frames=20)
     rec = run_scene(sc, a.out / "runs", np=a.np, log=print, name="stress_run")
     with h5py.File(rec.base + ".h5", "r") as f:
         names = sorted(f["frames"].keys())
@@ -481,7 +491,11 @@ def main(argv=None) -> int:
     p.add_argument("--margin", type=float, default=0.004,
                    help="convergence: the previous mesh's interval widened by this on both sides (m)")
     p.add_argument("--quick-skip-enstad", action="store_true", help="height: skip the Enstad-arch variant")
+    p.add_argument("--criterion", choices=CRITERIA, default=None,
+                   help="FLOW criterion of the studies (default: the generator's, physical); convergence: --criteria")
     a = p.parse_args(argv)
+    global CRITERION
+    CRITERION = a.criterion
     a.out = Path(a.out or f"out/arching/{a.study}")
     a.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
