@@ -415,6 +415,7 @@ def study_convergence(a) -> Study:
                                  n_elements=replace(sc, n_arc=n, outlet_width=lo or hi or start).n_elements(),
                                  fem_no_flow=lo, fem_flow=hi, runs=len(runs), wall=sum(walls),
                                  wall_per_run=sum(walls) / max(len(walls), 1), wall_max=max(walls, default=0.0),
+                                 cpu_per_run=sum(x.cpu for x in runs) / max(len(runs), 1),
                                  enstad=est["enstad"]))
                 r = rows[-1]
                 print(f"  -> {_cm(lo):.2f} .. {_cm(hi):.2f} cm, {len(runs)} runs, {r['wall']:.0f} s "
@@ -455,8 +456,9 @@ def _save_convergence(out: Path, rows: list[dict]) -> None:
 
 def convergence_table(rows: list[dict]) -> str:
     """Markdown table: per case and mesh, the interval under each criterion and its cost."""
-    lines = ["| case | n_arc | criterion | COW no flow .. flow (cm) | shift from the previous mesh (mm) | runs | wall (s) | wall per run (s) |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| case | n_arc | criterion | COW no flow .. flow (cm) | shift from the previous mesh (mm) | runs | wall (s) "
+             "| wall per run (s) | CPU per run (s, all ranks) |",
+             "|---|---|---|---|---|---|---|---|---|"]
     prev = {}
     for r in rows:
         key = (r["case"], r["criterion"])
@@ -465,7 +467,7 @@ def convergence_table(rows: list[dict]) -> str:
         prev[key] = mid
         lines.append(f"| {r['case']} ({r['reading']}, {r['height']:g} m) | {r['n_arc']} | {r['criterion']} | "
                      f"{_cm(r['fem_no_flow']):.2f} .. {_cm(r['fem_flow']):.2f} | {shift} | {r['runs']} | "
-                     f"{r['wall']:.0f} | {r['wall_per_run']:.1f} |")
+                     f"{r['wall']:.0f} | {r['wall_per_run']:.1f} | {float(r.get('cpu_per_run', 'nan')):.1f} |")
     return "\n".join(lines)
 
 
