@@ -1,4 +1,5 @@
 """bulkflow.arching.scene: geometry, mesh, material and steps of the arching scene generator."""
+import dataclasses
 import math
 
 import numpy as np
@@ -45,7 +46,8 @@ def test_outlet_width_and_elements():
     assert math.isclose(s.element_length(), 0.3 * math.radians(30) / 30, rel_tol=1e-12)
     assert s.n_elements() == 30 * s.n_radial()
     assert 2000 < s.n_elements() < 7000
-    assert math.isclose(s.flow_limit(), 0.5 * s.element_length())
+    assert math.isclose(s.flow_limit(), 0.03 * 0.3)                 # physical criterion: 3 % of B
+    assert math.isclose(dataclasses.replace(s, criterion="half-element").flow_limit(), 0.5 * s.element_length())
 
 
 def test_readings_and_cases():

@@ -451,11 +451,72 @@ def restart_steps(args):
     restart_scene(args, "restart_mpm", (REPO / "inputs/mpm/hopper_small_2d.inp").read_text())
 
 
+# ---- arching threshold (issue 21 point 4, one stability case of the FLOW criterion) -------------
+ARCH_TOL = 0.004        #: bisection tolerance of the coarse-mesh COW (m)
+ARCH_STEP = 0.005       #: the neighbours below and above the COW interval (m)
+#: increment perturbations: (label, scene overrides); SCALE FACTOR scales every step's stable
+#: increment, the mass-scaling factor the increment of the quasi-static steps only
+ARCH_PERTURBATIONS = [("dt x0.98", dict(dt_scale=0.98)), ("dt x1.02", dict(dt_scale=1.02)),
+                      ("mass scaling 3.9", dict(mass_scaling_dt_factor=3.9)),
+                      ("mass scaling 4.1", dict(mass_scaling_dt_factor=4.1))]
+
+
+def arching_outcome(args, width, tag="", **kw):
+    """Run the coarse Case B arching scene (1 m above the apex, 6 elements along the outlet, the
+    FLOW criterion of the scene generator, changed by --arching-override) at `width`; True = flows."""
+    sys.path.insert(0, str(REPO / "scripts"))
+    from bulkflow.arching.decision import ARREST, decide, read_stop_params
+    from bulkflow.arching.scene import scene_from_case
+    for item in filter(None, args.arching_override.split(",")):
+        key, value = item.split("=")
+        kw.setdefault(key.strip(), float(value))
+    s = scene_from_case("B", "c0", outlet_width=width, height=1.0, n_arc=6, t_gravity=0.3, t_slide=0.15,
+                        t_open=0.6, field_frames=0, **kw)
+    name = f"arch_{width * 1000:.1f}mm{tag}"
+    base, _, hist = run(args, name, s.inp_text())
+    finite_history(name, hist)
+    d = decide(str(base) + "_history.csv", read_stop_params(args.workdir / (name + ".inp")))
+    print(f"      B = {width * 100:6.2f} cm{tag:>22s}: {d.summary()}", flush=True)
+    return d.outcome != ARREST
+
+
+@case
+def arching_threshold(args):
+    """The flow/no-flow decision near the critical outlet width must not depend on the increment:
+    bisect the COW of a coarse Case B scene to 4 mm, then re-run the widths 5 mm below the
+    interval, its two ends and 5 mm above it with the stable increment scaled by 0.98 and 1.02
+    and with the mass-scaling factor of the quasi-static steps at 3.9 and 4.1 (default 4). For
+    every perturbation the outcomes, in increasing width, must switch once from arch to flow,
+    and the neighbours outside the interval must keep their outcome."""
+    lo, hi = 0.15, 0.60
+    check(not arching_outcome(args, lo), f"B = {lo * 100:g} cm arches (far below Enstad's 31 cm)")
+    check(arching_outcome(args, hi), f"B = {hi * 100:g} cm flows")
+    while hi - lo > ARCH_TOL:
+        mid = 0.5 * (lo + hi)
+        if arching_outcome(args, mid):
+            hi = mid
+        else:
+            lo = mid
+    print(f"      coarse COW: {lo * 100:.2f} .. {hi * 100:.2f} cm", flush=True)
+    widths = [lo - ARCH_STEP, lo, hi, hi + ARCH_STEP]
+    for label, kw in ARCH_PERTURBATIONS:
+        tag = "_" + label.replace(" ", "").replace(".", "p")
+        flows = [arching_outcome(args, w, tag, **kw) for w in widths]
+        pattern = "".join("F" if f else "A" for f in flows)
+        monotone = pattern in ("AAAF", "AAFF", "AFFF")
+        check(monotone, f"{label}: outcomes at {', '.join(f'{w * 100:.2f}' for w in widths)} cm = {pattern} "
+                        f"(A arch, F flow): one switch, the neighbours {ARCH_STEP * 1000:g} mm outside keep "
+                        f"their outcome")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("case", choices=sorted(CASES))
     p.add_argument("--bulkflow", required=True)
     p.add_argument("--workdir", type=Path, required=True)
+    p.add_argument("--arching-override", default="",
+                   help="arching-threshold: scene fields key=value,... over the generator's defaults, e.g. a "
+                        "broken criterion (docs/stability.md: the case then fails)")
     args = p.parse_args()
     CASES[args.case](args)
     print(f"PASS {args.case}")

@@ -111,6 +111,33 @@ class Search:
         return lo, hi
 
 
+def refine(srch: Search, lo: float | None, hi: float | None, n_arc: int, tol: float, start: float):
+    """On mesh `n_arc`: check the ends of a bracket [lo, hi] found elsewhere (a coarser mesh), widen
+    while they do not bracket, then bisect to `tol`. Without a bracket, expand from `start`."""
+    if lo is not None and hi is not None:
+        width = hi - lo
+        flo = srch.trial(lo, n_arc)
+        while flo and lo - width > 0.005:
+            hi, lo = lo, lo - width
+            width *= 2
+            flo = srch.trial(lo, n_arc)
+        if not flo:
+            fhi = srch.trial(hi, n_arc)
+            while not fhi and hi + width < srch.max_width():
+                lo, hi = hi, hi + width
+                width *= 2
+                fhi = srch.trial(hi, n_arc)
+            if not fhi:
+                hi = None
+        else:
+            lo = None
+    else:
+        lo, hi = srch.bracket(start, n_arc, lo, hi)
+    if lo is not None and hi is not None:
+        lo, hi = srch.bisect(lo, hi, n_arc, tol)
+    return lo, hi
+
+
 def find_cow(scene: ArchingScene, workdir, *, np: int = 2, tol: float = 0.002, coarse_n_arc: int = 12,
              coarse_tol: float | None = None, bracket: tuple | None = None, log=print) -> dict:
     """Run the search; returns a dict with the interval, the theories and every trial."""
@@ -134,27 +161,7 @@ def find_cow(scene: ArchingScene, workdir, *, np: int = 2, tol: float = 0.002, c
         if lo is not None and hi is not None:
             start = 0.5 * (lo + hi)
     log(f"target mesh (n_arc {scene.n_arc})")
-    if lo is not None and hi is not None:
-        width = hi - lo
-        flo = srch.trial(lo, scene.n_arc)
-        while flo and lo - width > 0.005:
-            hi, lo = lo, lo - width
-            width *= 2
-            flo = srch.trial(lo, scene.n_arc)
-        if not flo:
-            fhi = srch.trial(hi, scene.n_arc)
-            while not fhi and hi + width < srch.max_width():
-                lo, hi = hi, hi + width
-                width *= 2
-                fhi = srch.trial(hi, scene.n_arc)
-            if not fhi:
-                hi = None
-        else:
-            lo = None
-    else:
-        lo, hi = srch.bracket(start, scene.n_arc, lo, hi)
-    if lo is not None and hi is not None:
-        lo, hi = srch.bisect(lo, hi, scene.n_arc, tol)
+    lo, hi = refine(srch, lo, hi, scene.n_arc, tol, start)
     phases.append(dict(n_arc=scene.n_arc, interval=[lo, hi]))
     wall = time.perf_counter() - t0
     return dict(scene={k: v for k, v in vars(scene).items() if k != "title"}, theory=est, tol=tol,
@@ -180,7 +187,7 @@ def table(result: dict, title: str = "") -> str:
              f"  {'FEM (no flow, flow)':22s} {cm(lo)} .. {cm(hi)}"
              + (f"   width {(hi - lo) * 1000:.2f} mm" if lo is not None and hi is not None else "   (not bracketed)"),
              f"  cost: {result['n_runs']} runs, solver {result['solver_wall']:.0f} s, total {result['wall']:.0f} s "
-             f"(n_arc {s['n_arc']}, tol {result['tol'] * 1000:g} mm)"]
+             f"(n_arc {s['n_arc']}, tol {result['tol'] * 1000:g} mm, FLOW criterion {s.get('criterion', 'half-element')})"]
     return "\n".join(lines)
 
 

@@ -5,8 +5,10 @@ history holds what the decision needs: `UMAX_<NSET>` (largest displacement since
 over the node set) and `ALLKE`. This module re-derives the outcome from those rows with the
 same rules and the parameters written in the scene:
 
-* FLOW      — UMAX exceeds DISPLACEMENT (half the outlet element length by default: the thesis's
-              "whatever sliding occurred is less than one half of the mesh element length");
+* FLOW      — UMAX exceeds DISPLACEMENT (3 % of the outlet width B under the default, mesh-objective
+              criterion; half the outlet element length under `criterion="half-element"`, the
+              thesis's "whatever sliding occurred is less than one half of the mesh element
+              length"; scene.py writes it, README "The decision" says why);
 * ARREST    — UMAX stays below the limit and, from MIN TIME on, either ALLKE ≤ KINETIC FRACTION
               × its peak in the step for HOLD, or UMAX grew by ≤ GROWTH × limit over HOLD; a run
               that ended before its step period with UMAX below the limit was stopped by the

@@ -25,7 +25,8 @@ Steps (thesis §6.2):
   1. GRAVITY — gravity by smooth step, outlet plate closed (rigid arc, same friction as the wall);
   2. SLIDE   — (passive only) the plate moves a small distance toward the apex by smooth step;
   3. OPEN    — contact with the plate deleted; `*STOP CONDITION` ends the run at FLOW (largest
-               displacement since the opening > half the outlet element length) or ARREST.
+               displacement since the opening > 3 % of B, `criterion="physical"`, or > half the
+               outlet element length, `criterion="half-element"`, the thesis's rule) or ARREST.
 Steps 1-2 are quasi-static: `*FIXED MASS SCALING, DT=..., TYPE=BELOW MIN` scales the small outlet
 elements up to the given stable increment (`mass_scaling_dt_factor` × the smallest physical
 element increment); step 3 restores the physical masses (`FACTOR=1`).
@@ -49,6 +50,12 @@ from bulkflow.theory.cases import case as theory_case
 from bulkflow.theory.mohr import fc_from_c
 
 G = 9.81
+CRITERIA = ("physical", "half-element")
+#: physical FLOW limit as a fraction of the outlet width (README "The decision": why 2 %)
+FLOW_WIDTH_FRACTION = 0.03
+#: ARREST's creep rule, GROWTH of `*STOP CONDITION` per criterion: u_max grows by less than this ×
+#: the FLOW limit over HOLD (physical: 0.02 × 3 % B per 0.05 s = 0.012 B/s, ~4 mm/s at B = 35 cm)
+GROWTH = {"physical": 0.02, "half-element": 0.05}
 
 
 def fc0_from_c0(c0: float, phi_deg: float) -> float:
@@ -111,12 +118,17 @@ class ArchingScene:
     slide: float = 0.02
     t_open: float = 1.0              #: longest opening step (s); the stop condition ends it earlier
     mass_scaling_dt_factor: float = 4.0   #: steps 1-2: BELOW MIN to this × the smallest increment; ≤ 1: none
+    dt_scale: float = 1.0            #: *DYNAMIC SCALE FACTOR of every step (1: none written); perturbs the increments
     stop: bool = True                #: *STOP CONDITION in the opening step
-    flow_fraction: float = 0.5       #: FLOW limit as a fraction of the outlet element length
+    #: FLOW rule: "physical" (u_max > flow_width_fraction × B, the same on every mesh) or
+    #: "half-element" (u_max > flow_fraction × the outlet element length, thesis §6.2)
+    criterion: str = "physical"
+    flow_fraction: float = 0.5       #: half-element: FLOW limit as a fraction of the outlet element length
+    flow_width_fraction: float = FLOW_WIDTH_FRACTION   #: physical: FLOW limit as a fraction of B
     ke_fraction: float = 0.02        #: ARREST: ALLKE below this fraction of its peak ...
     hold: float = 0.05               #: ... for this long (s)
     min_open_time: float = 0.05      #: ARREST not before this step time (s)
-    growth: float = 0.05             #: ARREST also when u_max grows < this × the FLOW limit over `hold`
+    growth: float | None = None      #: ARREST also when u_max grows < this × the FLOW limit over `hold` (None: GROWTH[criterion])
     field_frames: int = 4            #: frames per step (0: none)
     history_points: int = 200        #: history rows per step
     gravity: float = G
@@ -271,24 +283,24 @@ class ArchingScene:
         outputs += [f"*OUTPUT, HISTORY, NUMBER INTERVAL={self.history_points}",
                     "*ENERGY OUTPUT, VARIABLE=PRESELECT", "*NODE OUTPUT, NSET=OUTLETN", "U2"]
         L += ["*STEP, NAME=GRAVITY, NLGEOM=YES", "Gravity by smooth step, outlet closed",
-              "*DYNAMIC, EXPLICIT", f", {fmt(self.t_gravity)}", "*BULK VISCOSITY", "0.06, 1.2"]
+              self.dynamic_line(), f", {fmt(self.t_gravity)}", "*BULK VISCOSITY", "0.06, 1.2"]
         if ms > 0:
             L += [f"*FIXED MASS SCALING, DT={ms:.6g}, TYPE=BELOW MIN"]
         L += ["*DLOAD, AMPLITUDE=RAMP", f"POWDER, GRAV, {fmt(self.gravity)}, 0., -1."]
         L += outputs + ["*END STEP"]
         if self.state == "passive":
             L += ["*STEP, NAME=SLIDE, NLGEOM=YES", "The plate slides toward the apex: passive state",
-                  "*DYNAMIC, EXPLICIT", f", {fmt(self.t_slide)}",
+                  self.dynamic_line(), f", {fmt(self.t_slide)}",
                   "*BOUNDARY, AMPLITUDE=SLIDE", f"PLATEREF, 2, 2, {-self.slide:.10g}", "*END STEP"]
         L += ["*STEP, NAME=OPEN, NLGEOM=YES", "Outlet opened: contact with the plate deleted",
-              "*DYNAMIC, EXPLICIT", f", {fmt(self.t_open)}"]
+              self.dynamic_line(), f", {fmt(self.t_open)}"]
         if ms > 0:
             L += ["*FIXED MASS SCALING, FACTOR=1"]
         L += ["*CONTACT PAIR, OP=DELETE", "POWDER_OUTLET, PLATE"]
         if self.stop:
             L += [f"*STOP CONDITION, NSET=ALLN, DISPLACEMENT={self.flow_limit():.6g}, "
                   f"KINETIC FRACTION={fmt(self.ke_fraction)}, HOLD={fmt(self.hold)}, "
-                  f"MIN TIME={fmt(self.min_open_time)}, GROWTH={fmt(self.growth)}"]
+                  f"MIN TIME={fmt(self.min_open_time)}, GROWTH={fmt(self.growth_fraction())}"]
         L += ["*END STEP", ""]
         return "\n".join(L)
 
@@ -298,8 +310,21 @@ class ArchingScene:
             return 0.0
         return self.mass_scaling_dt_factor * self.stable_dt() / 0.9
 
+    def dynamic_line(self) -> str:
+        if self.dt_scale == 1.0:
+            return "*DYNAMIC, EXPLICIT"
+        return f"*DYNAMIC, EXPLICIT, SCALE FACTOR={fmt(self.dt_scale)}"
+
+    def growth_fraction(self) -> float:
+        return GROWTH[self.criterion] if self.growth is None else self.growth
+
     def flow_limit(self) -> float:
-        return self.flow_fraction * self.element_length()
+        """The FLOW displacement of `*STOP CONDITION` (m) under the scene's criterion."""
+        if self.criterion == "physical":
+            return self.flow_width_fraction * self.outlet_width
+        if self.criterion == "half-element":
+            return self.flow_fraction * self.element_length()
+        raise ValueError(f"criterion {self.criterion!r}: expected one of {', '.join(CRITERIA)}")
 
     def write(self, path) -> Path:
         path = Path(path)
@@ -367,6 +392,11 @@ def add_scene_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--mass-scaling", type=float, default=d.mass_scaling_dt_factor,
                    help="steps 1-2: element increments raised to this x the smallest (<= 1: no mass scaling)")
     g.add_argument("--no-stop", action="store_true", help="no *STOP CONDITION: the opening step runs in full")
+    g.add_argument("--criterion", choices=CRITERIA, default=d.criterion,
+                   help="FLOW rule: u_max > --flow-width-fraction x B (physical) or > half the outlet element "
+                        "(half-element, thesis 6.2)")
+    g.add_argument("--flow-width-fraction", type=float, default=d.flow_width_fraction,
+                   help="physical criterion: the FLOW displacement as a fraction of the outlet width B")
     g.add_argument("--hold", type=float, default=d.hold)
     g.add_argument("--ke-fraction", type=float, default=d.ke_fraction)
     g.add_argument("--field-frames", type=int, default=d.field_frames)
@@ -400,7 +430,8 @@ def scene_from_args(a, outlet_width: float | None = None) -> ArchingScene:
     s = ArchingScene(**base, arch=a.arch, beta=beta, n_arc=a.n_arc, young=a.young, poisson=a.poisson,
                      flow=a.flow, table=table, state=a.state, t_gravity=a.t_gravity, t_slide=a.t_slide,
                      slide=a.slide, t_open=a.t_open, mass_scaling_dt_factor=a.mass_scaling,
-                     stop=not a.no_stop, hold=a.hold, ke_fraction=a.ke_fraction, field_frames=a.field_frames)
+                     stop=not a.no_stop, criterion=a.criterion, flow_width_fraction=a.flow_width_fraction,
+                     hold=a.hold, ke_fraction=a.ke_fraction, field_frames=a.field_frames)
     if outlet_width is not None:
         s.outlet_width = outlet_width
     return s

@@ -3,6 +3,7 @@
     bulkflow-arching-study height      [--quick]   # COW vs material height, Case A and B (Fig. 6.2, 6.8), + Enstad arch
     bulkflow-arching-study parametric  [--quick]   # θ, φw, φ, k around Case A at 2 m (Fig. 6.9)
     bulkflow-arching-study mesh        [--quick]   # elements along the outlet vs COW and wall time (Fig. 6.4)
+    bulkflow-arching-study convergence [--n-arcs 16,30,60]  # COW vs mesh, physical vs half-element FLOW rule
     bulkflow-arching-study elastic     [--quick]   # E and ν (Fig. 6.6)
     bulkflow-arching-study stress      [--quick]   # principal stresses along the wall vs Enstad (Fig. 6.7)
     bulkflow-arching-study powders     [--quick]   # Eckhoff & Leversen powders, both c0 readings, linear/bilinear (Table 6.3)
@@ -27,9 +28,19 @@ from pathlib import Path
 
 import numpy as np
 
-from .cow import find_cow, table, theory_estimates
+from .cow import Search, find_cow, refine, table, theory_estimates
 from .runner import run_scene
-from .scene import ArchingScene, enstad_beta, scene_from_case
+from .scene import CRITERIA, ArchingScene, enstad_beta, scene_from_case
+
+
+#: FLOW criterion of every study but `convergence` (None: the scene generator's default); --criterion
+CRITERION: str | None = None
+
+
+def case_scene(case: str, reading: str = "c0", **kw) -> ArchingScene:
+    if CRITERION is not None:
+        kw.setdefault("criterion", CRITERION)
+    return scene_from_case(case, reading, **kw)
 
 
 def _settings(quick: bool) -> dict:
@@ -109,12 +120,12 @@ def study_height(a) -> Study:
     heights = [1.0, 2.0, 3.0]
     for case in ("A", "B"):
         for h in heights:
-            sc = scene_from_case(case, "c0", height=h, n_arc=s["n_arc"])
+            sc = case_scene(case, "c0", height=h, n_arc=s["n_arc"])
             st.point(sc, case=case, reading="c0", variable="height", value=h, tol=s["tol"],
                      coarse_n_arc=s["coarse_n_arc"])
         if case == "A" and not a.quick_skip_enstad:
             for h in ([2.0] if a.quick else heights):
-                d = scene_from_case(case, "c0", height=h)
+                d = case_scene(case, "c0", height=h)
                 beta = enstad_beta(dict(rho=d.density, phi=d.phi, phi_w=d.phi_w, k=d.k, fc0=d.fc0, theta=d.theta,
                                         height=h))
                 sc = replace(d, arch="enstad", beta=beta, n_arc=s["n_arc"])
@@ -125,7 +136,7 @@ def study_height(a) -> Study:
     for ax, case in zip(axes, ("A", "B")):
         rows = [r for r in st.rows if r["case"] == case and r["variable"] == "height"]
         hs = np.linspace(0.6, 3.2, 27)
-        th = [theory_estimates(scene_from_case(case, "c0", height=h)) for h in hs]
+        th = [theory_estimates(case_scene(case, "c0", height=h)) for h in hs]
         for key, c in (("jenike", "g"), ("enstad", "r"), ("mclean", "k")):
             ax.plot(hs, [_cm(t[key]) for t in th], "-", color=c, lw=1, label=key.capitalize())
         _plot_points(ax, rows, label="FEM, arch centred at the apex")
@@ -148,7 +159,7 @@ def study_parametric(a) -> Study:
               "k": [0.0, 0.2, 0.4]}
     if a.quick:
         sweeps = {k: [v[0], v[-1]] for k, v in sweeps.items()}
-    base = scene_from_case("A", "c0", height=2.0, n_arc=s["n_arc"])
+    base = case_scene("A", "c0", height=2.0, n_arc=s["n_arc"])
     from .scene import fc0_from_c0
     for var, values in sweeps.items():
         for v in values:
@@ -177,7 +188,7 @@ def study_mesh(a) -> Study:
     ns = [10, 20, 30] if a.quick else [10, 20, 30, 60]
     h = a.height or 1.0
     for n in ns:
-        sc = scene_from_case("B", "c0", height=h, n_arc=n)
+        sc = case_scene("B", "c0", height=h, n_arc=n)
         st.point(sc, case="B", reading="c0", variable="n_arc", value=n, tol=0.002,
                  coarse_n_arc=10 if n > 10 else 0)
     plt = _plt()
@@ -198,7 +209,7 @@ def study_mesh(a) -> Study:
 def study_elastic(a) -> Study:
     st = Study("elastic", a.out, a.np)
     s = _settings(a.quick)
-    base = scene_from_case("A", "c0", height=2.0, n_arc=s["n_arc"])
+    base = case_scene("A", "c0", height=2.0, n_arc=s["n_arc"])
     sweeps = {"young": [5e6, 10e6, 40e6], "poisson": [0.1, 0.2, 0.3]}
     if a.quick:
         sweeps = {k: [v[0], v[-1]] for k, v in sweeps.items()}
@@ -226,7 +237,7 @@ def study_powders(a) -> Study:
         for reading in ("c0", "fc0"):
             for flow in (("linear",) if case == "polymer" else ("linear", "bilinear")):
                 h = a.height or (3.0 if (case == "polymer" and reading == "c0") else 1.0)
-                sc = scene_from_case(case, reading, height=h, n_arc=s["n_arc"], flow=flow)
+                sc = case_scene(case, reading, height=h, n_arc=s["n_arc"], flow=flow)
                 st.point(sc, case=case, reading=reading, variable="flow", value=flow, tol=s["tol"],
                          coarse_n_arc=s["coarse_n_arc"])
     with open(a.out / "powders_table.txt", "w") as f:
@@ -248,7 +259,7 @@ def study_benchmark(a) -> Study:
     st = Study("benchmark", a.out, a.np)
     for reading in ("fc0", "c0"):
         h = a.height or (3.0 if reading == "c0" else 1.0)
-        sc = scene_from_case("polymer", reading, height=h, n_arc=30)
+        sc = case_scene("polymer", reading, height=h, n_arc=30)
         t0 = time.perf_counter()
         st.point(sc, case="polymer", reading=reading, variable="benchmark", value=h, tol=0.002, coarse_n_arc=12)
         print(f"polymer, reading {reading}, H = {h} m: search wall time {time.perf_counter() - t0:.1f} s", flush=True)
@@ -277,7 +288,7 @@ def study_cost(a) -> Study:
     rows = []
     for name, kw in variants:
         for w in ends:
-            sc = scene_from_case("B", "c0", height=h, n_arc=s["n_arc"], outlet_width=w, field_frames=0, **kw)
+            sc = case_scene("B", "c0", height=h, n_arc=s["n_arc"], outlet_width=w, field_frames=0, **kw)
             tag = name.replace(" ", "_")
             try:
                 rec = run_scene(sc, a.out / "runs" / tag, np=a.np, log=print)
@@ -317,7 +328,7 @@ def study_stress(a) -> Study:
     h = a.height or 2.0
     n = 16 if a.quick else 30
     width = a.width or 0.26
-    sc = scene_from_case("B", "c0", height=h, n_arc=n, outlet_width=width, field_frames=20)
+    sc = case_scene("B", "c0", height=h, n_arc=n, outlet_width=width, field_frames=20)
     rec = run_scene(sc, a.out / "runs", np=a.np, log=print, name="stress_run")
     with h5py.File(rec.base + ".h5", "r") as f:
         names = sorted(f["frames"].keys())
@@ -368,8 +379,101 @@ def study_stress(a) -> Study:
     return st
 
 
+def study_convergence(a) -> Study:
+    """The COW on refined meshes under each FLOW criterion (issue 21): Case B (1 m unless --height)
+    and the polymer (fc0 reading, 1 m). Per case and criterion one search runs from the coarsest
+    mesh up: bracket and bisect on the first mesh, then on each finer mesh check the previous
+    interval widened by --margin on both sides (widened further while it does not bracket) and
+    bisect to 2 mm. One CSV row per (case, criterion, mesh): the interval, the runs on that mesh
+    and their wall time."""
+    st = Study("convergence", a.out, a.np)
+    ns = [int(v) for v in a.n_arcs.split(",")]
+    crits = a.criteria.split(",") if a.criteria else list(CRITERIA)
+    cases = [c for c in (("B", "c0", a.height or 1.0), ("polymer", "fc0", 1.0)) if c[0] in a.cases.split(",")]
+    rows = []
+    for case, reading, h in cases:
+        for crit in crits:
+            sc = scene_from_case(case, reading, height=h, n_arc=ns[0], criterion=crit, field_frames=0)
+            tag = f"{case}_{reading}_{crit}"
+            srch = Search(sc, a.out / "runs" / tag, a.np, lambda m: print(m, flush=True))
+            est = theory_estimates(sc)
+            start = next((est[k] for k in ("enstad", "jenike", "mclean") if est[k] and math.isfinite(est[k])), 0.2)
+            lo = hi = None
+            for n in ns:
+                print(f"convergence: case {case} ({reading}), criterion {crit}, n_arc {n}", flush=True)
+                k0 = len(srch.runs)
+                if lo is not None and hi is not None:
+                    lo, hi = lo - a.margin, hi + a.margin
+                    lo, hi = refine(srch, lo, hi, n, 0.002, 0.5 * (lo + hi))
+                else:
+                    lo, hi = srch.bracket(min(start, 0.9 * srch.max_width()), n)
+                    if lo is not None and hi is not None:
+                        lo, hi = srch.bisect(lo, hi, n, 0.002)
+                runs = srch.runs[k0:]
+                walls = [r.wall for r in runs]
+                rows.append(dict(case=case, reading=reading, height=h, criterion=crit, n_arc=n,
+                                 n_elements=replace(sc, n_arc=n, outlet_width=lo or hi or start).n_elements(),
+                                 fem_no_flow=lo, fem_flow=hi, runs=len(runs), wall=sum(walls),
+                                 wall_per_run=sum(walls) / max(len(walls), 1), wall_max=max(walls, default=0.0),
+                                 cpu_per_run=sum(x.cpu for x in runs) / max(len(runs), 1),
+                                 enstad=est["enstad"]))
+                r = rows[-1]
+                print(f"  -> {_cm(lo):.2f} .. {_cm(hi):.2f} cm, {len(runs)} runs, {r['wall']:.0f} s "
+                      f"({r['wall_per_run']:.1f} s per run)", flush=True)
+                _save_convergence(a.out, rows)
+            st.results.append(dict(case=case, reading=reading, criterion=crit,
+                                   runs=[x.as_dict() for x in srch.runs]))
+    _save_convergence(a.out, rows)
+    (a.out / "convergence.json").write_text(json.dumps(dict(rows=rows, searches=st.results), default=str))
+    plt = _plt()
+    fig, axs = plt.subplots(1, len(cases), figsize=(5 * len(cases), 4), squeeze=False)
+    for ax, (case, reading, h) in zip(axs[0], cases):
+        for crit, c in zip(crits, ("tab:blue", "tab:red")):
+            rr = [r for r in rows if r["case"] == case and r["criterion"] == crit and r["fem_no_flow"]
+                  and r["fem_flow"]]
+            x = [r["n_arc"] for r in rr]
+            ax.fill_between(x, [_cm(r["fem_no_flow"]) for r in rr], [_cm(r["fem_flow"]) for r in rr],
+                            color=c, alpha=0.4)
+            ax.plot(x, [0.5 * (_cm(r["fem_no_flow"]) + _cm(r["fem_flow"])) for r in rr], "o-", color=c, label=crit)
+        ax.set_xscale("log")
+        ax.set_xlabel("elements along the outlet arc")
+        ax.set_ylabel("critical outlet width (cm)")
+        ax.set_title(f"{case} ({reading}), H = {h:g} m")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(a.out / "convergence.png", dpi=120)
+    print(convergence_table(rows))
+    return st
+
+
+def _save_convergence(out: Path, rows: list[dict]) -> None:
+    with open(out / "convergence.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    (out / "convergence_table.txt").write_text(convergence_table(rows) + "\n")
+
+
+def convergence_table(rows: list[dict]) -> str:
+    """Markdown table: per case and mesh, the interval under each criterion and its cost."""
+    lines = ["| case | n_arc | criterion | COW no flow .. flow (cm) | shift from the previous mesh (mm) | runs | wall (s) "
+             "| wall per run (s) | CPU per run (s, all ranks) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    prev = {}
+    for r in rows:
+        key = (r["case"], r["criterion"])
+        mid = (0.5 * (r["fem_no_flow"] + r["fem_flow"]) if r["fem_no_flow"] and r["fem_flow"] else None)
+        shift = f"{(mid - prev[key]) * 1000:+.1f}" if mid is not None and prev.get(key) is not None else "—"
+        prev[key] = mid
+        lines.append(f"| {r['case']} ({r['reading']}, {r['height']:g} m) | {r['n_arc']} | {r['criterion']} | "
+                     f"{_cm(r['fem_no_flow']):.2f} .. {_cm(r['fem_flow']):.2f} | {shift} | {r['runs']} | "
+                     f"{r['wall']:.0f} | {r['wall_per_run']:.1f} | {float(r.get('cpu_per_run', 'nan')):.1f} |")
+    return "\n".join(lines)
+
+
 STUDIES = dict(height=study_height, parametric=study_parametric, mesh=study_mesh, elastic=study_elastic,
-               stress=study_stress, powders=study_powders, benchmark=study_benchmark, cost=study_cost)
+               stress=study_stress, powders=study_powders, benchmark=study_benchmark, cost=study_cost,
+               convergence=study_convergence)
 
 
 def main(argv=None) -> int:
@@ -383,8 +487,17 @@ def main(argv=None) -> int:
     p.add_argument("--width", type=float, default=None, help="stress: the outlet width (m)")
     p.add_argument("--bracket", default="", help="cost: lo,hi (m) to skip the coarse bracket")
     p.add_argument("--t-open", type=float, default=0.5, help="cost: the opening step without early stop (s)")
+    p.add_argument("--n-arcs", default="16,30,60", help="convergence: the meshes, coarsest first")
+    p.add_argument("--criteria", default="", help="convergence: FLOW criteria (default: physical,half-element)")
+    p.add_argument("--cases", default="B,polymer", help="convergence: B and/or polymer")
+    p.add_argument("--margin", type=float, default=0.004,
+                   help="convergence: the previous mesh's interval widened by this on both sides (m)")
     p.add_argument("--quick-skip-enstad", action="store_true", help="height: skip the Enstad-arch variant")
+    p.add_argument("--criterion", choices=CRITERIA, default=None,
+                   help="FLOW criterion of the studies (default: the generator's, physical); convergence: --criteria")
     a = p.parse_args(argv)
+    global CRITERION
+    CRITERION = a.criterion
     a.out = Path(a.out or f"out/arching/{a.study}")
     a.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
