@@ -53,6 +53,13 @@ DRIFT_BOUND = 0.001
 REST_BOUND = 1.0e-6
 
 
+def verdict(ok):
+    """Print each criterion's outcome; are they all met?"""
+    for what, good in ok.items():
+        print(f"  {'ok  ' if good else 'FAIL'} {what}")
+    return all(ok.values())
+
+
 def scene(material, period, history_rows):
     """The verification column with the hold's period, a history row every period/history_rows and
     one field frame at the end; `material` elastic or mohr-coulomb."""
@@ -138,9 +145,7 @@ def long_run(exe, workdir, material, increments):
     print(f"  at rest: ALLKE/ALLIE {rest:.2e} (bound {REST_BOUND:g}); base sigma_22 {s:.1f} Pa, "
           f"closed form {exact:.1f} Pa ({100 * (s - exact) / exact:+.2f} %); sigma_11/sigma_22 {ratio:.5f}, "
           f"closed form {ratio_exact:.5f}")
-    for what, good in ok.items():
-        print(f"  {'ok  ' if good else 'FAIL'} {what}")
-    return all(ok.values())
+    return verdict(ok)
 
 
 def mpm_scene(period, history_rows):
@@ -188,9 +193,7 @@ def mpm_long_run(exe, workdir, increments):
     print(f"  at rest: ALLKE/ALLIE {rest:.2e} (bound {REST_BOUND:g}); lowest row sigma_22 {s22:.1f} Pa, "
           f"closed form {exact:.1f} Pa ({100 * (s22 - exact) / exact:+.2f} %); "
           f"sigma_11/sigma_22 {float(np.mean(stress[low, 0])) / s22:.4f} (K0 = 0.25)")
-    for what, good in ok.items():
-        print(f"  {'ok  ' if good else 'FAIL'} {what}")
-    return all(ok.values())
+    return verdict(ok)
 
 
 def main():

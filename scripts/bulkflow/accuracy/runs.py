@@ -7,14 +7,11 @@ from __future__ import annotations
 
 import importlib.util
 import re
-import resource
 import shutil
-import subprocess
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..arching.runner import mpi_environment, solver_path
+from ..arching.runner import run_timed, solver_path
 
 REPO = Path(__file__).resolve().parents[3]
 _DONE = re.compile(r"bulkflow: done, (\d+) increments")
@@ -39,13 +36,7 @@ def run_deck(text: str, workdir: Path, name: str, ranks: int = 1, solver: str | 
     cmd = [str(solver_path(solver)), str(inp), "--output", str(base), "--quiet"]
     if ranks > 1:
         cmd = [shutil.which("mpirun") or "mpirun", "-np", str(ranks)] + cmd
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=mpi_environment())
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
-    (workdir / f"{name}.log").write_text(proc.stdout + proc.stderr)
+    proc, wall, cpu = run_timed(cmd, workdir / f"{name}.log")
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed with status {proc.returncode}:\n"
                            f"{(proc.stdout + proc.stderr)[-2000:]}")

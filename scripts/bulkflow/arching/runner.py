@@ -63,6 +63,19 @@ class RunRecord:
 _DONE = re.compile(r"bulkflow: done, (\d+) increments")
 
 
+def run_timed(cmd: list[str], log: Path) -> tuple[subprocess.CompletedProcess, float, float]:
+    """Run a solver command line with the MPI environment: the finished process, its wall time
+    and the CPU time (user + system) of the children it started [s]; stdout and stderr go to `log`."""
+    t0 = time.perf_counter()
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=mpi_environment())
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    log.write_text(proc.stdout + proc.stderr)
+    return proc, wall, cpu
+
+
 def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = None, name: str | None = None,
               keep: bool = True, log=None) -> RunRecord:
     """Write the scene, run it on `np` ranks, decide. Raises RuntimeError if the solver fails."""
@@ -76,13 +89,7 @@ def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = No
     if np > 1:
         mpirun = shutil.which("mpirun") or "mpirun"
         cmd = [mpirun, "-np", str(np)] + cmd
-    t0 = time.perf_counter()
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=mpi_environment())
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
-    (workdir / f"{name}.log").write_text(proc.stdout + proc.stderr)
+    proc, wall, cpu = run_timed(cmd, workdir / f"{name}.log")
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed with status {proc.returncode}:\n{proc.stderr[-2000:]}")
     params = read_stop_params(inp)
