@@ -116,17 +116,7 @@ contains
           call p2g(st, st%blocks(ib))
        end if
     end do
-    if (st%nranks > 1) then
-       call fx%stop(fx_p2g)
-       call fx%start(fx_exchange)
-       if (st%dom%on) then
-          call halo_sum_p2g(st)
-       else
-          call reduce_grid(st, .true.)
-       end if
-       call fx%stop(fx_exchange)
-       call fx%start(fx_p2g)
-    end if
+    call exchange_grid_sums(st, fx, fx_p2g, .true.)
     st%g%mass_own = st%g%mass
     st%wall_force = 0
     do k = 1, size(m%mpm%walls)
@@ -191,17 +181,7 @@ contains
           call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
        end if
     end do
-    if (st%nranks > 1) then
-       call fx%stop(fx_g2p)
-       call fx%start(fx_exchange)
-       if (st%dom%on) then
-          call halo_sum_momentum(st)
-       else
-          call reduce_grid(st, .false.)
-       end if
-       call fx%stop(fx_exchange)
-       call fx%start(fx_g2p)
-    end if
+    call exchange_grid_sums(st, fx, fx_g2p, .false.)
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
     end do
@@ -287,6 +267,30 @@ contains
     end if
     u = u + dt * v
   end subroutine rigid_surface_motion
+
+  !> The grid's sums over the ranks inside a transfer phase (`phase`, paused meanwhile so that the
+  !> exchange has a timer of its own): after P2G (all_fields: mass, momentum, force) or after the
+  !> remap (momentum), by the halo of the spatial decomposition or by an all-reduce of the
+  !> replicated grid. Nothing on one rank. Collective.
+  subroutine exchange_grid_sums(st, fx, phase, all_fields)
+    type(mpm_state_t), intent(inout) :: st
+    type(effects_t), intent(inout) :: fx
+    integer, intent(in) :: phase
+    logical, intent(in) :: all_fields
+
+    if (st%nranks == 1) return
+    call fx%stop(phase)
+    call fx%start(fx_exchange)
+    if (st%dom%on .and. all_fields) then
+       call halo_sum_p2g(st)
+    else if (st%dom%on) then
+       call halo_sum_momentum(st)
+    else
+       call reduce_grid(st, all_fields)
+    end if
+    call fx%stop(fx_exchange)
+    call fx%start(phase)
+  end subroutine exchange_grid_sums
 
   !> Sum the grid arrays over ranks: after P2G mass, momentum and force, after the remap momentum.
   subroutine reduce_grid(st, all_fields)
