@@ -57,8 +57,9 @@ def main() -> int:
     p.add_argument('--repeats', type=int, default=5)
     p.add_argument('--n-across', type=int, default=60, help='elements across the hopper outlet (size)')
     a = p.parse_args()
-    bulkflow = a.build / 'bin' / 'bulkflow'
-    single = a.build / 'abaqus' / 'bulkflow_abaqus.f'
+    build = a.build.resolve()   # the runs start in a scratch folder: a relative --build must not follow them
+    bulkflow = build / 'bin' / 'bulkflow'
+    single = build / 'abaqus' / 'bulkflow_abaqus.f'
     work = Path(tempfile.mkdtemp(prefix='bench_user_'))
     env = dict(os.environ, BULKFLOW_CACHE_DIR=str(work / 'cache'))
     make_hopper = REPO / '.venv' / 'bin' / 'bulkflow-make-hopper'
