@@ -179,15 +179,24 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     w("** gravity: ramped in the fill step, then on at full value (amplitude in total time)")
     w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME")
     w(f"0., 0., {ramp:g}, 1.")
+    lines += bin_steps(fill_time, discharge_time, field_dt, history_dt)
+    return "\n".join(lines) + "\n"
+
+
+def bin_steps(fill_time, discharge_time, field_dt, history_dt, gravity="9.81, 0., -1.", fields="S, SDV"):
+    """The two steps of a bin run (2D scenes and the 3D slab): FILL with the outlet closed and
+    gravity ramped by the amplitude RAMP (one field frame at its end), DISCHARGE with the outlet
+    wall deleted and no damping."""
+    lines = []
     steps = (("FILL", "Outlet closed: the fill settles under gravity", fill_time,
-              ["*DLOAD, AMPLITUDE=RAMP", ", GRAV, 9.81, 0., -1."], fill_time),
+              ["*DLOAD, AMPLITUDE=RAMP", f", GRAV, {gravity}"], fill_time),
              ("DISCHARGE", "Outlet open: the bin empties through the outlet", discharge_time,
               ["*MPM CONTROLS, DAMPING=0.", "*MPM WALL, NAME=OUTLET, OP=DELETE"], field_dt))
     for name, text, period, loads, frame_dt in steps:
         lines += [f"*STEP, NAME={name}", text, "*DYNAMIC, EXPLICIT", f", {period:g}", *loads,
-                  f"*OUTPUT, FIELD, TIME INTERVAL={frame_dt:g}", "*ELEMENT OUTPUT", "S, SDV",
+                  f"*OUTPUT, FIELD, TIME INTERVAL={frame_dt:g}", "*ELEMENT OUTPUT", fields,
                   f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}", "*ENERGY OUTPUT", "*END STEP"]
-    return "\n".join(lines) + "\n"
+    return lines
 
 
 def main(argv=None):

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from .bin_scene import (CASES, OUTLET, PHI_CV, PHI_WALL, POISSON, PSI_MAX, RHO_CV, RHO_I, SANDS, YOUNG,
-                        _material, bin_geometry, bin_scene, eps_cv)
+                        _material, bin_geometry, bin_scene, bin_steps, eps_cv)
 
 SMALL = dict(outlet=0.05, width=0.2, fill=0.2, cell=0.01)   # the small bin of inputs/mpm/bin_small_*
 
@@ -102,14 +102,7 @@ def slab_scene(case="concentric", sand="NDNS", gap_cells=4, cell=None, edge_cell
     w(f"*OUTFLOW, BELOW={_f(-outflow_cells * h)}")
     w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME")
     w(f"0., 0., {ramp:g}, 1.")
-    steps = (("FILL", "Outlet closed: the fill settles under gravity", fill_time,
-              ["*DLOAD, AMPLITUDE=RAMP", ", GRAV, 9.81, 0., -1., 0."], fill_time),
-             ("DISCHARGE", "Outlet open: the bin empties through the outlet", discharge_time,
-              ["*MPM CONTROLS, DAMPING=0.", "*MPM WALL, NAME=OUTLET, OP=DELETE"], field_dt))
-    for name, text, period, loads, frame_dt in steps:
-        lines += [f"*STEP, NAME={name}", text, "*DYNAMIC, EXPLICIT", f", {period:g}", *loads,
-                  f"*OUTPUT, FIELD, TIME INTERVAL={frame_dt:g}", "*ELEMENT OUTPUT", "S",
-                  f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}", "*ENERGY OUTPUT", "*END STEP"]
+    lines += bin_steps(fill_time, discharge_time, field_dt, history_dt, gravity="9.81, 0., -1., 0.", fields="S")
     return "\n".join(lines) + "\n", g, t
 
 
