@@ -9,7 +9,7 @@ module mpm_flow
   use mpm_state, only: mpm_state_t
   use mpm_particles, only: particle_block_size, block_keep, drop_empty_blocks
   use mpm_walls, only: wall_contains, wall_distance, wall_rows_behind, wall_slide_velocity
-  use mpm_setup, only: add_particles
+  use mpm_lattice, only: add_particles
   use parallel_comm, only: comm_max_owner, comm_any, comm_sum
   implicit none
   private

@@ -21,7 +21,7 @@ module mpm_migrate
   implicit none
   private
 
-  public :: decompose_initial, migrate_particles, rebalance_check, repartition, record_length, &
+  public :: decompose_start, decompose_boxes, migrate_particles, rebalance_check, repartition, record_length, &
        pack_record, unpack_records, domain_increment_end
 
 contains
@@ -274,16 +274,13 @@ contains
     counts = reshape(flat, shape(counts))
   end subroutine global_cell_counts
 
-  !> The first decomposition: every rank made all particles (same order); the boxes come from
-  !> their counts per cell and each rank keeps those in its box, re-packed into full blocks.
-  !> No communication (every rank sees every particle).
-  subroutine decompose_initial(m, st, rebalance)
-    type(model_t), intent(in) :: m
+  !> The domain before any particle exists: the mirrored planes' node layers and the ranks'
+  !> layout (mpm_domain's domain_init); decompose_boxes then cuts it by the particle counts.
+  subroutine decompose_start(st, rebalance)
     type(mpm_state_t), intent(inout) :: st
     real(dp), intent(in) :: rebalance
-    integer, allocatable :: counts(:, :, :), axis(:), layer(:)
-    integer :: ib, p, c(3), k, nmir, pos, total
-    real(dp), allocatable :: buf(:)
+    integer, allocatable :: axis(:), layer(:)
+    integer :: k, nmir
 
     nmir = count(st%mirrored)
     allocate (axis(nmir), layer(nmir))
@@ -296,31 +293,15 @@ contains
        layer(nmir) = plane_layer(st, k)
     end do
     call domain_init(st%dom, st%rank, st%nranks, st%nd, st%g%n, st%nsup, axis, layer, rebalance)
-    allocate (counts(st%dom%ncell(1), st%dom%ncell(2), st%dom%ncell(3)))
-    counts = 0
-    do ib = 1, st%nblocks
-       do p = 1, st%blocks(ib)%count
-          c = cell_of(st%dom, st%g%lo, st%g%h, st%blocks(ib)%x(p, :))
-          counts(c(1) + 1, c(2) + 1, c(3) + 1) = counts(c(1) + 1, c(2) + 1, c(3) + 1) + 1
-       end do
-    end do
+  end subroutine decompose_start
+
+  !> The first partition: the ranks' boxes from the particle counts per cell of the whole set
+  !> (every rank has the same counts: the same boxes, no communication).
+  subroutine decompose_boxes(st, counts)
+    type(mpm_state_t), intent(inout) :: st
+    integer, intent(in) :: counts(:, :, :)
     call domain_build(st%dom, rcb_boxes(counts, st%nranks))
-    total = 0
-    do ib = 1, st%nblocks
-       total = total + st%blocks(ib)%count * record_length(st%nd, st%nc, size(st%blocks(ib)%state, 2), &
-            size(st%blocks(ib)%field, 2))
-    end do
-    allocate (buf(total))
-    pos = 1
-    do ib = 1, st%nblocks
-       do p = 1, st%blocks(ib)%count
-          c = cell_of(st%dom, st%g%lo, st%g%h, st%blocks(ib)%x(p, :))
-          if (rank_of_cell(st%dom, c) == st%rank) call pack_record(st%blocks(ib), p, st%nd, buf, pos)
-       end do
-    end do
-    st%nblocks = 0
-    call unpack_records(m, st, buf(1:pos - 1))
-  end subroutine decompose_initial
+  end subroutine decompose_boxes
 
   !> The node layer of mirrored plane k along its axis.
   integer function plane_layer(st, k) result(layer)

@@ -1,68 +1,46 @@
 !> Set-up of a material-point run: the state's sizes, grid, per-material moduli and VUMAT work
-!> sets, the particles of the *PARTICLES regions (a regular lattice of PPC particles per cell
-!> and direction), their split over the ranks, the walls' node lists and mirrors, and the
-!> effects the scene asks for. Also the particle factory inflow uses (`add_particles`) and the
+!> sets, the particles of the *PARTICLES regions (made by mpm_lattice) and their split over the
+!> ranks, the walls' node lists and mirrors, and the effects the scene asks for. Also the
 !> step's wall-node marks (`mark_wall_nodes`).
 module mpm_setup
   use base_kinds, only: dp
   use error_report, only: raise_error
   use material_props, only: model_from_name, model_unknown
   use model, only: model_t
-  use mpm_scene, only: particle_region_t, region_box, region_polygon, decomposition_spatial
-  use mpm_migrate, only: decompose_initial
+  use mpm_scene, only: decomposition_spatial
+  use mpm_migrate, only: decompose_start, decompose_boxes
+  use mpm_lattice, only: lattice_tally_t, tally_region, tally_close, generate_region
   use mpm_halo, only: domain_regrid
   use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
        fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_side_friction, &
        fx_exchange, fx_migration
   use output_effects, only: effects_t
   use mpm_grid, only: grid_init
-  use mpm_particles, only: particle_block_t, particle_block_size, block_allocate, block_grow
+  use mpm_particles, only: particle_block_size
   use mpm_shape, only: stencil_nodes_per_direction
   use mpm_walls, only: wall_find_nodes
   use mpm_mirror, only: mirror_plane_setup
   use mpm_stress_update, only: material_work_init
   use material_door, only: checked_packaging_modulus
-  use model_particle_fields, only: particle_initial_field
   implicit none
   private
 
-  public :: mpm_setup_run, setup_state, setup_walls, generate_region, region_contains, add_particles, mark_wall_nodes
+  public :: mpm_setup_run, setup_state, setup_walls, mark_wall_nodes
 
 contains
 
-  !> The whole set-up of a run: state, particles (this rank's share), walls, effects.
+  !> The whole set-up of a run: state, walls, particles (this rank's share), effects.
   subroutine mpm_setup_run(m, st, fx)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(effects_t), intent(inout) :: fx
+    type(lattice_tally_t) :: tally
     integer :: k, s
+    logical :: spatial
 
     call setup_state(m, st)
+    spatial = st%nranks > 1 .and. m%mpm%decomposition == decomposition_spatial
     associate (mpm => m%mpm)
-      allocate (st%blocks(16))
-      st%nblocks = 0
-      do k = 1, size(mpm%regions)
-         call generate_region(m, st, mpm%regions(k))
-      end do
-      if (st%nblocks == 0) call raise_error(trim(m%input_file), 0, 'the *PARTICLES regions hold no ' // &
-           'particle centre; expected regions at least one particle spacing (CELL/PPC) wide')
-      st%mass_initial = 0
-      do k = 1, st%nblocks
-         st%mass_initial = st%mass_initial + sum(st%blocks(k)%mass)
-      end do
-      st%mass_cutoff = 1.0e-9_dp * maxval([(maxval(st%blocks(k)%mass), k = 1, st%nblocks)])
-      st%n_initial = sum(st%blocks(1:st%nblocks)%count)
-      ! every rank made all blocks (same order); each keeps every nranks-th one (the spatial
-      ! decomposition keeps the particles of its box instead, once the mirrors are known)
-      if (st%nranks > 1 .and. m%mpm%decomposition /= decomposition_spatial) then
-         s = 0
-         do k = 1, st%nblocks
-            if (mod(k - 1, st%nranks) /= st%rank) cycle
-            s = s + 1
-            if (s /= k) st%blocks(s) = st%blocks(k)
-         end do
-         st%nblocks = s
-      end if
       allocate (st%wall_nodes(size(mpm%walls)), st%wall_force(3, size(mpm%walls)))
       allocate (st%wall_impulse(3, size(mpm%walls)), st%wall_force_row(3, size(mpm%walls)))
       st%wall_force = 0
@@ -73,14 +51,56 @@ contains
       st%rigid_u = 0
       st%rigid_v = 0
       call setup_walls(m, st)
-      if (st%nranks > 1 .and. m%mpm%decomposition == decomposition_spatial) then
-         ! the rank's box of the grid, its particles, and the walls on its held nodes
-         call decompose_initial(m, st, m%mpm%rebalance)
+      allocate (st%blocks(16))
+      st%nblocks = 0
+      if (spatial) then
+         ! the boxes from the whole set's counts per cell, then only this rank's particles
+         ! (mpm_lattice: the same numbers, totals and blocks as if all were made)
+         call decompose_start(st, m%mpm%rebalance)
+         do k = 1, size(mpm%regions)
+            call tally_region(m, st, mpm%regions(k), tally)
+         end do
+         call tally_close(tally)
+         if (tally%particles == 0) call no_particles()
+         call decompose_boxes(st, tally%counts)
+         deallocate (tally%counts)
+         do k = 1, size(mpm%regions)
+            call generate_region(m, st, mpm%regions(k), owner_only=.true.)
+         end do
+         st%mass_initial = tally%mass
+         st%mass_cutoff = 1.0e-9_dp * tally%largest_mass
+         st%n_initial = tally%particles
          call domain_regrid(st)
          call setup_walls(m, st)
+      else
+         do k = 1, size(mpm%regions)
+            call generate_region(m, st, mpm%regions(k))
+         end do
+         if (st%nblocks == 0) call no_particles()
+         st%mass_initial = 0
+         do k = 1, st%nblocks
+            st%mass_initial = st%mass_initial + sum(st%blocks(k)%mass)
+         end do
+         st%mass_cutoff = 1.0e-9_dp * maxval([(maxval(st%blocks(k)%mass), k = 1, st%nblocks)])
+         st%n_initial = sum(st%blocks(1:st%nblocks)%count)
+      end if
+      ! replicated grid: every rank made all blocks (same order); each keeps every nranks-th one
+      if (st%nranks > 1 .and. .not. spatial) then
+         s = 0
+         do k = 1, st%nblocks
+            if (mod(k - 1, st%nranks) /= st%rank) cycle
+            s = s + 1
+            if (s /= k) st%blocks(s) = st%blocks(k)
+         end do
+         st%nblocks = s
       end if
     end associate
     call setup_effects(m, st%nranks, fx)
+  contains
+    subroutine no_particles()
+      call raise_error(trim(m%input_file), 0, 'the *PARTICLES regions hold no ' // &
+           'particle centre; expected regions at least one particle spacing (CELL/PPC) wide')
+    end subroutine no_particles
   end subroutine mpm_setup_run
 
   !> The walls' node lists and the mirrored symmetry planes on the rank's grid (again after a
@@ -176,130 +196,6 @@ contains
     call fx%declare(fx_exchange, 'grid exchange', active=nranks > 1)
     call fx%declare(fx_migration, 'migration', active=nranks > 1 .and. m%mpm%decomposition == decomposition_spatial)
   end subroutine setup_effects
-
-  !> A regular lattice of ppc particles per cell and direction (aligned with the grid), kept
-  !> where the particle centre lies in the region.
-  subroutine generate_region(m, st, r)
-    type(model_t), intent(in) :: m
-    type(mpm_state_t), intent(inout) :: st
-    type(particle_region_t), intent(in) :: r
-    real(dp) :: dx, x(3), lo(3)
-    integer :: i0(3), i1(3), i, j, k, n, nd
-    real(dp), allocatable :: pts(:, :)
-
-    nd = st%nd
-    dx = m%mpm%cell / r%ppc
-    lo = m%mpm%lo
-    i0 = 0
-    i1 = 0
-    do k = 1, nd
-       i0(k) = floor((r%lo(k) - lo(k)) / dx)
-       i1(k) = ceiling((r%hi(k) - lo(k)) / dx)
-    end do
-    allocate (pts(3, product(i1(1:nd) - i0(1:nd) + 1)))
-    n = 0
-    do k = i0(3), i1(3)
-       do j = i0(2), i1(2)
-          do i = i0(1), i1(1)
-             x = lo + ([real(dp) :: i, j, k] + 0.5_dp) * dx
-             if (nd == 2) x(3) = 0
-             if (.not. region_contains(r, nd, x)) cycle
-             n = n + 1
-             pts(:, n) = x
-          end do
-       end do
-    end do
-    call add_particles(m, st, r%material, r%ppc, pts(:, 1:n), r%velocity)
-  end subroutine generate_region
-
-  !> Is x inside the region (a box: lo ≤ x < hi; a polygon by ray casting, in 3D also z)?
-  logical function region_contains(r, nd, x) result(inside)
-    type(particle_region_t), intent(in) :: r
-    integer, intent(in) :: nd
-    real(dp), intent(in) :: x(3)
-    integer :: i, j, nv
-
-    if (r%kind == region_box) then
-       inside = all(x(1:nd) >= r%lo(1:nd)) .and. all(x(1:nd) < r%hi(1:nd))
-       return
-    end if
-    inside = .false.
-    if (nd == 3) then
-       if (x(3) < r%lo(3) .or. x(3) >= r%hi(3)) return
-    end if
-    nv = size(r%polygon, 2)
-    j = nv
-    do i = 1, nv
-       if ((r%polygon(2, i) > x(2)) .neqv. (r%polygon(2, j) > x(2))) then
-          if (x(1) < (r%polygon(1, j) - r%polygon(1, i)) * (x(2) - r%polygon(2, i)) / &
-               (r%polygon(2, j) - r%polygon(2, i)) + r%polygon(1, i)) inside = .not. inside
-       end if
-       j = i
-    end do
-    if (r%kind /= region_polygon) inside = .false.
-  end function region_contains
-
-  !> Append particles of one material and spacing CELL/ppc at pts(3, n) (zero stress, F = I):
-  !> first into the last block of that material and spacing, then into new blocks.
-  subroutine add_particles(m, st, material, ppc, pts, velocity)
-    type(model_t), intent(in) :: m
-    type(mpm_state_t), intent(inout) :: st
-    integer, intent(in) :: material, ppc
-    real(dp), intent(in) :: pts(:, :)
-    real(dp), intent(in) :: velocity(:)
-    type(particle_block_t), allocatable :: grown(:)
-    real(dp) :: dx, vol, half
-    integer :: n, done, ib, first, add, p, nd, k
-
-    nd = st%nd
-    n = size(pts, 2)
-    dx = m%mpm%cell / ppc
-    vol = dx**nd
-    half = 0.5_dp * dx
-    done = 0
-    do while (done < n)
-       ib = 0
-       if (st%nblocks > 0) then
-          if (st%blocks(st%nblocks)%material == material .and. abs(st%blocks(st%nblocks)%half - half) <= &
-               1.0e-12_dp * half .and. st%blocks(st%nblocks)%count < particle_block_size) ib = st%nblocks
-       end if
-       if (ib == 0) then
-          if (.not. allocated(st%blocks)) allocate (st%blocks(16))
-          if (st%nblocks == size(st%blocks)) then
-             allocate (grown(2 * st%nblocks))
-             grown(1:st%nblocks) = st%blocks(1:st%nblocks)
-             call move_alloc(grown, st%blocks)
-          end if
-          st%nblocks = st%nblocks + 1
-          ib = st%nblocks
-          call block_allocate(st%blocks(ib), 0, nd, st%nc, max(1, m%materials(material)%nstatev), &
-               max(1, m%materials(material)%nfieldv), st%nsup)
-          st%blocks(ib)%material = material
-          st%blocks(ib)%half = half
-       end if
-       associate (b => st%blocks(ib))
-         first = b%count + 1
-         add = min(n - done, particle_block_size - b%count)
-         call block_grow(b, b%count + add, nd)
-         do p = 1, add
-            st%next_number = st%next_number + 1
-            b%number(first + p - 1) = st%next_number
-            b%x(first + p - 1, :) = pts(1:nd, done + p)
-            b%v(first + p - 1, :) = velocity(1:nd)
-         end do
-         b%vol0(first:) = vol
-         b%mass(first:) = m%materials(material)%density * vol
-         ! *INITIAL CONDITIONS, TYPE=FIELD of the material's particles (for a user's VUMAT or
-         ! VUSDFLD, as in elements; inflow particles start with them too)
-         if (m%materials(material)%user_code .or. m%materials(material)%user_field_code) then
-            do k = 1, size(b%field, 2)
-               b%field(first:, k) = particle_initial_field(m, material, k)
-            end do
-         end if
-       end associate
-       done = done + add
-    end do
-  end subroutine add_particles
 
   !> The nodes the active walls of the step constrain: local damping leaves them alone, so that
   !> it does not change the reactions (the wall forces) of a body at rest.
