@@ -375,32 +375,49 @@ contains
   subroutine grid_update(st, damping)
     type(mpm_state_t), intent(inout) :: st
     real(dp), intent(in) :: damping           !< local damping coefficient a of the step
-    integer :: i, k
-    real(dp) :: a, f, dt, damp
 
-    a = damping
-    dt = st%dt
-    ! Inactive nodes keep zero velocities: both arrays are cleared in one go first (per node,
-    ! `v(:, i) = 0` was a memset call each, two for every inactive node).
-    call grid_clear(st%nd * st%g%nn, st%g%v_old)
-    call grid_clear(st%nd * st%g%nn, st%g%v_new)
-    do i = 1, st%g%nn
-       st%g%active(i) = st%g%mass(i) > st%mass_cutoff
-       if (.not. st%g%active(i)) cycle
-       do k = 1, st%nd
-          st%g%v_old(k, i) = st%g%mom(k, i) / st%g%mass(i)
-          f = st%g%force(k, i)
-          if (a > 0 .and. abs(st%g%v_old(k, i)) > 0 .and. .not. st%on_wall(i)) then
+    call grid_update_nodes(st%g%nn, st%nd, damping, st%dt, st%mass_cutoff, st%g%mass, st%g%mass_own, st%g%mom, &
+         st%g%force, st%on_wall, st%g%active, st%g%v_old, st%g%v_new, st%e_damping)
+  end subroutine grid_update
+
+  !> grid_update's node loop. Explicit-shape dummies (issue 19): on the grid's allocatable
+  !> components the loop went through their descriptors at every access. Inactive nodes get zero
+  !> velocities here, in the same pass (no clearing of the two whole arrays first); the active
+  !> ones' values and the damping energy's sum (node order) are the arithmetic of before.
+  pure subroutine grid_update_nodes(nn, nd, a, dt, cutoff, mass, mass_own, mom, force, on_wall, active, v_old, v_new, &
+       e_damping)
+    integer, intent(in) :: nn, nd
+    real(dp), intent(in) :: a, dt, cutoff, mass(nn), mass_own(nn), mom(nd, nn), force(nd, nn)
+    logical, intent(in) :: on_wall(nn)
+    logical, intent(out) :: active(nn)
+    real(dp), intent(out) :: v_old(nd, nn), v_new(nd, nn)
+    real(dp), intent(inout) :: e_damping
+    integer :: i, k
+    real(dp) :: f, damp
+
+    do i = 1, nn
+       active(i) = mass(i) > cutoff
+       if (.not. active(i)) then
+          do k = 1, nd
+             v_old(k, i) = 0
+             v_new(k, i) = 0
+          end do
+          cycle
+       end if
+       do k = 1, nd
+          v_old(k, i) = mom(k, i) / mass(i)
+          f = force(k, i)
+          if (a > 0 .and. abs(v_old(k, i)) > 0 .and. .not. on_wall(i)) then
              ! Cundall's local non-viscous damping: opposes the motion, proportional to |f|
              damp = a * abs(f)
-             f = f - sign(damp, st%g%v_old(k, i))
+             f = f - sign(damp, v_old(k, i))
              ! the real material's share of the node (image mass folded in: mpm_mirror)
-             st%e_damping = st%e_damping + damp * abs(st%g%v_old(k, i)) * dt * st%g%mass_own(i) / st%g%mass(i)
+             e_damping = e_damping + damp * abs(v_old(k, i)) * dt * mass_own(i) / mass(i)
           end if
-          st%g%v_new(k, i) = st%g%v_old(k, i) + dt * f / st%g%mass(i)
+          v_new(k, i) = v_old(k, i) + dt * f / mass(i)
        end do
     end do
-  end subroutine grid_update
+  end subroutine grid_update_nodes
 
   !> Grid to particles: PIC/FLIP blend (alpha: 1 FLIP, 0 PIC) of the velocity, position from the
   !> new grid velocity; then (MUSL) the block's new momentum goes back to the grid (st%g%mom,
@@ -435,10 +452,23 @@ contains
   !> grid_update's zero (the walls project active nodes only).
   subroutine remap_velocity(st)
     type(mpm_state_t), intent(inout) :: st
-    integer :: i
 
-    do i = 1, st%g%nn
-       if (st%g%active(i)) st%g%v_new(:, i) = st%g%mom(:, i) / st%g%mass(i)
-    end do
+    call remap_velocity_nodes(st%g%nn, st%nd, st%g%active, st%g%mass, st%g%mom, st%g%v_new)
   end subroutine remap_velocity
+
+  !> remap_velocity's node loop on explicit-shape dummies (as grid_update_nodes).
+  pure subroutine remap_velocity_nodes(nn, nd, active, mass, mom, v_new)
+    integer, intent(in) :: nn, nd
+    logical, intent(in) :: active(nn)
+    real(dp), intent(in) :: mass(nn), mom(nd, nn)
+    real(dp), intent(inout) :: v_new(nd, nn)
+    integer :: i, k
+
+    do i = 1, nn
+       if (.not. active(i)) cycle
+       do k = 1, nd
+          v_new(k, i) = mom(k, i) / mass(i)
+       end do
+    end do
+  end subroutine remap_velocity_nodes
 end module mpm_musl
