@@ -102,8 +102,10 @@ contains
     real(dp), intent(in) :: dt
     real(dp), intent(out) :: reaction(3)
     logical, intent(in), optional :: owned(:)
-    integer :: k, f, b, a, nd
-    real(dp) :: m, p(g%ndim), fo(g%ndim), v(g%ndim), exchange(g%ndim)
+    ! fixed-size locals, the components 1:nd used: with (g%ndim)-sized ones and an array-valued
+    ! reflect gfortran allocated temporaries on the heap for every node pair (issue 19)
+    integer :: k, f, b, a, nd, j
+    real(dp) :: m, p(3), fo(3), v(3), exchange(3), sf, sb
 
     nd = g%ndim
     a = mp%axis
@@ -120,20 +122,30 @@ contains
        b = mp%back(k)
        m = g%mass(f) + g%mass(b)
        if (m <= 0) cycle
-       p = g%mom(:, f) + reflect(g%mom(:, b), a)
-       fo = g%force(:, f) + reflect(g%force(:, b), a)
-       v = (p + dt * fo) / m
-       if (counted(f)) exchange = exchange + g%mass_own(f) * v - own_share(g, f) * (g%mom(:, f) + dt * g%force(:, f)) &
-            + g%mass_own(b) * reflect(v, a) - own_share(g, b) * (g%mom(:, b) + dt * g%force(:, b))
+       do j = 1, nd
+          p(j) = g%mom(j, f) + reflected(g%mom(j, b), j, a)
+          fo(j) = g%force(j, f) + reflected(g%force(j, b), j, a)
+          v(j) = (p(j) + dt * fo(j)) / m
+       end do
+       if (counted(f)) then
+          sf = own_share(g, f)
+          sb = own_share(g, b)
+          do j = 1, nd
+             exchange(j) = exchange(j) + g%mass_own(f) * v(j) - sf * (g%mom(j, f) + dt * g%force(j, f)) &
+                  + g%mass_own(b) * reflected(v(j), j, a) - sb * (g%mom(j, b) + dt * g%force(j, b))
+          end do
+       end if
        g%mass(f) = m
        g%mass(b) = m
-       g%mom(:, f) = p
-       g%mom(:, b) = reflect(p, a)
-       g%force(:, f) = fo
-       g%force(:, b) = reflect(fo, a)
+       do j = 1, nd
+          g%mom(j, f) = p(j)
+          g%mom(j, b) = reflected(p(j), j, a)
+          g%force(j, f) = fo(j)
+          g%force(j, b) = reflected(fo(j), j, a)
+       end do
     end do
     reaction = 0
-    reaction(1:nd) = -exchange / dt
+    reaction(1:nd) = -exchange(1:nd) / dt
   contains
     logical function counted(node)
       integer, intent(in) :: node
@@ -146,8 +158,8 @@ contains
   subroutine mirror_fold_momentum(mp, g)
     type(mirror_plane_t), intent(in) :: mp
     type(grid_t), intent(inout) :: g
-    integer :: k, f, b, a
-    real(dp) :: p(g%ndim)
+    integer :: k, f, b, a, j
+    real(dp) :: p
 
     a = mp%axis
     do k = 1, size(mp%plane)
@@ -156,9 +168,11 @@ contains
     do k = 1, size(mp%front)
        f = mp%front(k)
        b = mp%back(k)
-       p = g%mom(:, f) + reflect(g%mom(:, b), a)
-       g%mom(:, f) = p
-       g%mom(:, b) = reflect(p, a)
+       do j = 1, g%ndim
+          p = g%mom(j, f) + reflected(g%mom(j, b), j, a)
+          g%mom(j, f) = p
+          g%mom(j, b) = reflected(p, j, a)
+       end do
     end do
   end subroutine mirror_fold_momentum
 
@@ -174,11 +188,12 @@ contains
     if (g%mass(i) > 0) own_share = g%mass_own(i) / g%mass(i)
   end function own_share
 
-  pure function reflect(v, axis) result(r)
-    real(dp), intent(in) :: v(:)
-    integer, intent(in) :: axis
-    real(dp) :: r(size(v))
-    r = v
-    r(axis) = -v(axis)
-  end function reflect
+  !> Component j of a vector reflected across the plane normal to axis: −x on the axis, else x
+  !> (scalar, so no array temporary).
+  pure real(dp) function reflected(x, j, axis)
+    real(dp), intent(in) :: x
+    integer, intent(in) :: j, axis
+    reflected = x
+    if (j == axis) reflected = -x
+  end function reflected
 end module mpm_mirror

@@ -13,7 +13,7 @@ module mpm_musl
   use model_steps, only: bc_velocity
   use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_walls, fx_exchange, max_over_ranks, det_f
   use mpm_grid, only: grid_sum_length, grid_reset_sums, grid_clear
-  use mpm_particles, only: particle_block_t
+  use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_shape, only: block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles
   use mpm_sort, only: sort_due, sort_blocks
@@ -347,60 +347,87 @@ contains
   !> Particle to grid: mass, momentum, internal and gravity forces. The particle factors
   !> (m v, V σ, m g) are formed first in block loops that vectorize; the scatter then does one
   !> multiply-add per value and node.
+  !> The factors' work arrays are fixed-size locals of particle_block_size rows' room, seen by
+  !> p2g_factors and the scatter as (count, ·) arrays (sequence association): as automatic arrays
+  !> of b%count rows gfortran allocated them on the heap per block and increment (issue 19).
   subroutine p2g(st, b)
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(in) :: b
-    integer :: p, k, nd, nb
-    real(dp) :: vol(b%count)
-    real(dp) :: mv(b%count, st%nd), vs(b%count, st%nc), mg(b%count, st%nd)
+    real(dp) :: mv(3 * particle_block_size), vs(6 * particle_block_size), mg(3 * particle_block_size)
 
-    nd = st%nd
-    nb = b%count
+    call p2g_factors(b%count, st%nd, st%nc, b%vol0, b%f, b%stress_global, b%mass, b%v, st%gravity, mv, vs, mg)
+    call scatter_p2g(b%count, st%nsup, st%nd, st%nc, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+         b%dw1, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
+  end subroutine p2g
+
+  !> p2g's particle factors m v, V σ (V = V0 det F) and m g of a block.
+  pure subroutine p2g_factors(nb, nd, nc, vol0, f, stress, mass, v, gravity, mv, vs, mg)
+    integer, intent(in) :: nb, nd, nc
+    real(dp), intent(in) :: vol0(nb), f(nb, nd, nd), stress(nb, nc), mass(nb), v(nb, nd), gravity(3)
+    real(dp), intent(out) :: mv(nb, nd), vs(nb, nc), mg(nb, nd)
+    real(dp) :: vol(particle_block_size)
+    integer :: p, k
+
     ! column by column (particle index innermost): the row-wise form was a quarter of p2g
     do p = 1, nb
-       vol(p) = b%vol0(p) * det_f(b%f, p, nd)
+       vol(p) = vol0(p) * det_f(f, p, nd)
     end do
-    do k = 1, st%nc
-       vs(:, k) = vol * b%stress_global(:, k)
+    do k = 1, nc
+       vs(:, k) = vol(1:nb) * stress(:, k)
     end do
     do k = 1, nd
-       mv(:, k) = b%mass * b%v(:, k)
-       mg(:, k) = b%mass * st%gravity(k)
+       mv(:, k) = mass * v(:, k)
+       mg(:, k) = mass * gravity(k)
     end do
-    call scatter_p2g(nb, st%nsup, nd, st%nc, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
-         b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
-  end subroutine p2g
+  end subroutine p2g_factors
 
   !> v_I^n = p_I/m_I; [local damping f ← f − a|f| sgn v]; v_I^{n+1} = v_I^n + Δt f_I/m_I.
   subroutine grid_update(st, damping)
     type(mpm_state_t), intent(inout) :: st
     real(dp), intent(in) :: damping           !< local damping coefficient a of the step
-    integer :: i, k
-    real(dp) :: a, f, dt, damp
 
-    a = damping
-    dt = st%dt
-    ! Inactive nodes keep zero velocities: both arrays are cleared in one go first (per node,
-    ! `v(:, i) = 0` was a memset call each, two for every inactive node).
-    call grid_clear(st%nd * st%g%nn, st%g%v_old)
-    call grid_clear(st%nd * st%g%nn, st%g%v_new)
-    do i = 1, st%g%nn
-       st%g%active(i) = st%g%mass(i) > st%mass_cutoff
-       if (.not. st%g%active(i)) cycle
-       do k = 1, st%nd
-          st%g%v_old(k, i) = st%g%mom(k, i) / st%g%mass(i)
-          f = st%g%force(k, i)
-          if (a > 0 .and. abs(st%g%v_old(k, i)) > 0 .and. .not. st%on_wall(i)) then
+    call grid_update_nodes(st%g%nn, st%nd, damping, st%dt, st%mass_cutoff, st%g%mass, st%g%mass_own, st%g%mom, &
+         st%g%force, st%on_wall, st%g%active, st%g%v_old, st%g%v_new, st%e_damping)
+  end subroutine grid_update
+
+  !> grid_update's node loop. Explicit-shape dummies (issue 19): on the grid's allocatable
+  !> components the loop went through their descriptors at every access. Inactive nodes get zero
+  !> velocities here, in the same pass (no clearing of the two whole arrays first); the active
+  !> ones' values and the damping energy's sum (node order) are the arithmetic of before.
+  pure subroutine grid_update_nodes(nn, nd, a, dt, cutoff, mass, mass_own, mom, force, on_wall, active, v_old, v_new, &
+       e_damping)
+    integer, intent(in) :: nn, nd
+    real(dp), intent(in) :: a, dt, cutoff, mass(nn), mass_own(nn), mom(nd, nn), force(nd, nn)
+    logical, intent(in) :: on_wall(nn)
+    logical, intent(out) :: active(nn)
+    real(dp), intent(out) :: v_old(nd, nn), v_new(nd, nn)
+    real(dp), intent(inout) :: e_damping
+    integer :: i, k
+    real(dp) :: f, damp
+
+    do i = 1, nn
+       active(i) = mass(i) > cutoff
+       if (.not. active(i)) then
+          do k = 1, nd
+             v_old(k, i) = 0
+             v_new(k, i) = 0
+          end do
+          cycle
+       end if
+       do k = 1, nd
+          v_old(k, i) = mom(k, i) / mass(i)
+          f = force(k, i)
+          if (a > 0 .and. abs(v_old(k, i)) > 0 .and. .not. on_wall(i)) then
              ! Cundall's local non-viscous damping: opposes the motion, proportional to |f|
              damp = a * abs(f)
-             f = f - sign(damp, st%g%v_old(k, i))
+             f = f - sign(damp, v_old(k, i))
              ! the real material's share of the node (image mass folded in: mpm_mirror)
-             st%e_damping = st%e_damping + damp * abs(st%g%v_old(k, i)) * dt * st%g%mass_own(i) / st%g%mass(i)
+             e_damping = e_damping + damp * abs(v_old(k, i)) * dt * mass_own(i) / mass(i)
           end if
-          st%g%v_new(k, i) = st%g%v_old(k, i) + dt * f / st%g%mass(i)
+          v_new(k, i) = v_old(k, i) + dt * f / mass(i)
        end do
     end do
-  end subroutine grid_update
+  end subroutine grid_update_nodes
 
   !> Grid to particles: PIC/FLIP blend (alpha: 1 FLIP, 0 PIC) of the velocity, position from the
   !> new grid velocity; then (MUSL) the block's new momentum goes back to the grid (st%g%mom,
@@ -409,36 +436,59 @@ contains
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(inout) :: b
     real(dp), intent(in) :: alpha
-    integer :: p, k, nd, nb
-    real(dp) :: vpic(b%count, st%nd), dv(b%count, st%nd), dt, wk
+    ! fixed-size work arrays seen as (count, nd) by the kernels (as in p2g: no heap allocation)
+    real(dp) :: vpic(3 * particle_block_size), dv(3 * particle_block_size), wk
 
-    nd = st%nd
-    nb = b%count
-    dt = st%dt
-    call gather_velocity(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, st%g%v_new, &
-         st%g%v_old, vpic, dv)
+    call gather_velocity(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+         st%g%v_new, st%g%v_old, vpic, dv)
+    call g2p_update(b%count, st%nd, alpha, st%dt, st%gravity, b%mass, vpic, dv, b%v, b%x, wk)
+    st%w_external = st%w_external + wk
+    call scatter_momentum(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, dv, &
+         st%g%mom)
+  end subroutine g2p
+
+  !> g2p's particle update: PIC/FLIP velocity, position, the gravity's work wk; dv returns the
+  !> particles' momentum m v for the remap.
+  pure subroutine g2p_update(nb, nd, alpha, dt, gravity, mass, vpic, dv, v, x, wk)
+    integer, intent(in) :: nb, nd
+    real(dp), intent(in) :: alpha, dt, gravity(3), mass(nb), vpic(nb, nd)
+    real(dp), intent(inout) :: dv(nb, nd), v(nb, nd), x(nb, nd)
+    real(dp), intent(out) :: wk
+    integer :: p, k
+
     wk = 0
     do k = 1, nd
        do p = 1, nb
-          b%v(p, k) = alpha * (b%v(p, k) + dv(p, k)) + (1 - alpha) * vpic(p, k)
-          b%x(p, k) = b%x(p, k) + dt * vpic(p, k)
-          wk = wk + b%mass(p) * st%gravity(k) * dt * vpic(p, k)
+          v(p, k) = alpha * (v(p, k) + dv(p, k)) + (1 - alpha) * vpic(p, k)
+          x(p, k) = x(p, k) + dt * vpic(p, k)
+          wk = wk + mass(p) * gravity(k) * dt * vpic(p, k)
           ! from here on dv holds the particle momentum for the remap
-          dv(p, k) = b%mass(p) * b%v(p, k)
+          dv(p, k) = mass(p) * v(p, k)
        end do
     end do
-    st%w_external = st%w_external + wk
-    call scatter_momentum(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, dv, st%g%mom)
-  end subroutine g2p
+  end subroutine g2p_update
 
   !> The remapped velocity v_I = p_I/m_I on the active nodes. Inactive nodes: v_new is still
   !> grid_update's zero (the walls project active nodes only).
   subroutine remap_velocity(st)
     type(mpm_state_t), intent(inout) :: st
-    integer :: i
 
-    do i = 1, st%g%nn
-       if (st%g%active(i)) st%g%v_new(:, i) = st%g%mom(:, i) / st%g%mass(i)
-    end do
+    call remap_velocity_nodes(st%g%nn, st%nd, st%g%active, st%g%mass, st%g%mom, st%g%v_new)
   end subroutine remap_velocity
+
+  !> remap_velocity's node loop on explicit-shape dummies (as grid_update_nodes).
+  pure subroutine remap_velocity_nodes(nn, nd, active, mass, mom, v_new)
+    integer, intent(in) :: nn, nd
+    logical, intent(in) :: active(nn)
+    real(dp), intent(in) :: mass(nn), mom(nd, nn)
+    real(dp), intent(inout) :: v_new(nd, nn)
+    integer :: i, k
+
+    do i = 1, nn
+       if (.not. active(i)) cycle
+       do k = 1, nd
+          v_new(k, i) = mom(k, i) / mass(i)
+       end do
+    end do
+  end subroutine remap_velocity_nodes
 end module mpm_musl

@@ -22,6 +22,7 @@
 !> stencil order from zero, whatever the loop nesting; a scatter adds to a node the blocks'
 !> particles stencil node by stencil node (s outer, p inner), the order of the earlier code.
 module mpm_transfer
+  use, intrinsic :: iso_fortran_env, only: int64
   use base_kinds, only: dp
   implicit none
   private
