@@ -47,7 +47,8 @@ contains
     integer, intent(in) :: group(n)
     real(dp), intent(out) :: avg(n)
     integer :: nbin(3), p, q, j, k, nkeys, c(3), lo3(3), hi3(3), i1, i2, i3, key
-    integer, allocatable :: bin(:), order(:), first(:)
+    integer, allocatable :: bin(:), order(:), first(:), gb(:)
+    real(dp), allocatable :: xb(:, :), fb(:), vb(:)
     real(dp) :: xlo(3), xhi(3), side, r2, radius2, w, sw, swf, xs(nd)
 
     avg = f
@@ -84,6 +85,15 @@ contains
        first(key) = j
        j = j + q
     end do
+    ! the particles in bin order, positions (nd, n): the inner loop reads consecutive memory
+    allocate (xb(nd, n), fb(n), vb(n), gb(n))
+    do j = 1, n
+       q = order(j)
+       xb(:, j) = x(q, :)
+       fb(j) = f(q)
+       vb(j) = vol(q)
+       gb(j) = group(q)
+    end do
     radius2 = radius * radius
     do p = 1, n
        if (group(p) == 0) cycle
@@ -101,13 +111,15 @@ contains
              do i1 = lo3(1), hi3(1)
                 key = 1 + i1 + nbin(1) * (i2 + nbin(2) * i3)
                 do j = first(key), first(key + 1) - 1
-                   q = order(j)
-                   if (group(q) /= group(p)) cycle
-                   r2 = sum((x(q, :) - xs)**2)
+                   if (gb(j) /= group(p)) cycle
+                   r2 = 0
+                   do k = 1, nd
+                      r2 = r2 + (xb(k, j) - xs(k))**2
+                   end do
                    if (r2 >= radius2) cycle
-                   w = bell_weight(r2, radius2) * vol(q)
+                   w = bell_weight(r2, radius2) * vb(j)
                    sw = sw + w
-                   swf = swf + w * (f(q) - f(p))
+                   swf = swf + w * (fb(j) - f(p))
                 end do
              end do
           end do
