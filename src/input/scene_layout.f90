@@ -43,7 +43,7 @@ contains
     select case (name)
     case ('HEADING', 'NODE', 'ELEMENT', 'NSET', 'ELSET', 'SOLID SECTION', 'MATERIAL', &
          'SURFACE', 'RIGID BODY', 'SURFACE INTERACTION', 'INITIAL CONDITIONS', 'SECTION CONTROLS', &
-         'MPM GRID', 'PARTICLES', 'OUTFLOW')
+         'MPM GRID', 'PARTICLES', 'OUTFLOW', 'NONLOCAL')
        keyword_kind = kw_model
     case ('DYNAMIC', 'DLOAD', 'DSLOAD', 'BULK VISCOSITY', 'OUTPUT', 'RESTART', 'FIXED MASS SCALING', &
           'STOP CONDITION', 'INFLOW', 'TEMPERATURE')

@@ -11,6 +11,7 @@
 !>                                                  data 3D: px, py, pz, nx, ny, nz [; lo; hi]
 !>   *OUTFLOW, BELOW=y                              model data: particles below y leave
 !>   *INFLOW, MATERIAL=name, LEVEL=y [, PPC=n]      in a step: data x1, x2 (3D: x1, z1, x2, z2)
+!>   *NONLOCAL, LENGTH=l [, VARIABLE=FVn] [, MATERIAL=name]   model data: scene_mpm_nonlocal
 !>
 !> Rigid surfaces are walls too: *SURFACE, TYPE=SEGMENTS (2D) or any 3D rigid surface (PLANE,
 !> REVOLUTION, ...) (+ *RIGID BODY on a *NODE moved by *BOUNDARY) paired with the particles by
@@ -32,6 +33,7 @@ module scene_mpm
   use scene_materials, only: find_material
   use scene_mpm_side, only: read_side_friction
   use scene_mpm_decomposition, only: read_decomposition
+  use scene_mpm_nonlocal, only: read_nonlocal
   use scene_util, only: itoa, rtoa, get_real, expect_lines, expect_fields, last_field, where_text, &
        check_name
   implicit none
@@ -45,7 +47,7 @@ contains
   pure logical function mpm_keyword(name)
     character(len=*), intent(in) :: name
     select case (name)
-    case ('MPM GRID', 'MPM CONTROLS', 'PARTICLES', 'MPM WALL', 'OUTFLOW', 'INFLOW', 'MPM SIDE FRICTION')
+    case ('MPM GRID', 'MPM CONTROLS', 'PARTICLES', 'MPM WALL', 'OUTFLOW', 'INFLOW', 'MPM SIDE FRICTION', 'NONLOCAL')
        mpm_keyword = .true.
     case default
        mpm_keyword = .false.
@@ -148,6 +150,8 @@ contains
               call read_wall(blk, mpm, 0, max(nsteps, 1), err)
            case ('OUTFLOW')
               call read_outflow(blk, mpm, err)
+           case ('NONLOCAL')
+              call read_nonlocal(blk, model, err)
            case ('INFLOW')
               call blk%fail('*INFLOW outside a step; expected it inside the step where material flows in', err)
            end select
@@ -177,7 +181,7 @@ contains
                  call read_wall(blk, mpm, s, nsteps, err)
               case ('INFLOW')
                  call read_inflow(blk, model, carry, err)
-              case ('PARTICLES', 'OUTFLOW', 'MPM GRID')
+              case ('PARTICLES', 'OUTFLOW', 'MPM GRID', 'NONLOCAL')
                  call blk%fail('*' // blk%name // ' inside a step; expected it in the model data ' // &
                       '(before the first *STEP)', err)
               end select

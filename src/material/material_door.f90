@@ -44,7 +44,7 @@ module material_door
      real(dp), allocatable :: e_int_new(:), e_inel_new(:), density(:), direct(:, :, :)
   end type vumat_work_t
 
-  public :: vumat_work_init, call_material, packaging_modulus, checked_packaging_modulus
+  public :: vumat_work_init, call_material, call_field, packaging_modulus, checked_packaging_modulus
   public :: packaging_moduli, checked_packaging_moduli
 
   !> The strain increment of the packaging call (direction 11).
@@ -83,9 +83,12 @@ contains
 
   !> One increment of the material of a block: [vusdfld] then vumat. Arrays are the block's
   !> (nb, ...) arrays; on return stress/state/field/energies hold the new values.
+  !> With `field_given` (the MPM's *NONLOCAL, docs/nonlocal.md) the VUSDFLD has run already
+  !> (call_field, its state written to `state`): field_given is the VUMAT's fieldNew, `field` its
+  !> fieldOld, and field_given becomes the block's field.
   subroutine call_material(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, &
        char_length, density, strain_inc, rel_spin, stretch_old, stretch_new, defgrad_old, &
-       defgrad_new, log_strain, stress, state, field, e_int, e_inel, w)
+       defgrad_new, log_strain, stress, state, field, e_int, e_inel, w, field_given)
     type(material_t), intent(in) :: mat
     integer, intent(in) :: nb, ncomp, nshr
     integer, intent(in) :: elem_number(nb)
@@ -102,13 +105,14 @@ contains
     ! Allocatable for the same reason as stress and state.
     real(dp), allocatable, intent(inout) :: e_int(:), e_inel(:)
     type(vumat_work_t), intent(inout) :: w
+    real(dp), intent(in), optional :: field_given(:, :)
     integer :: nstatev, nfieldv, nprops, ns, nf, piece, i0
     procedure(), pointer :: umat
 
     if (mat%user_code) then
        call call_user_material(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, char_length, &
             density, strain_inc, rel_spin, stretch_old, stretch_new, defgrad_old, defgrad_new, log_strain, &
-            stress, state, field, e_int, e_inel, w)
+            stress, state, field, e_int, e_inel, w, field_given)
        return
     end if
     umat => vumat_entry(.false.)
@@ -124,7 +128,15 @@ contains
     nf = size(field, 2)
     w%jblock(1:4) = [nb, 1, 1, 1]
     w%jblock(5:4 + nb) = elem_number
-    if (mat%user_field) then
+    if (present(field_given)) then
+       ! the VUSDFLD's state is the block's already (call_field): stateOld is the block's state
+       call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
+            mat%vumat_name, w%coord(1:nb, :), char_length, mat%props, density, strain_inc, rel_spin, &
+            w%temp(1:nb), stretch_old, defgrad_old, field(1:nb, 1:nf), stress, state(1:nb, 1:ns), &
+            e_int, e_inel, w%temp_new(1:nb), stretch_new, defgrad_new, field_given(1:nb, 1:nf), &
+            w%stress_new(1:nb, :), w%state_new(1:nb, 1:ns), w%e_int_new(1:nb), w%e_inel_new(1:nb))
+       field(1:nb, 1:nf) = field_given(1:nb, 1:nf)
+    else if (mat%user_field) then
        ! A user's VUSDFLD gets at most n_vec_length points a call (Abaqus's nblock), ours the
        ! whole block; each point's answer depends on that point alone.
        w%field_new(1:nb, 1:nfieldv) = field(1:nb, 1:nfieldv)
@@ -160,13 +172,44 @@ contains
     call swap_or_copy_1d(e_inel, w%e_inel_new, nb)
   end subroutine call_material
 
+  !> The material's VUSDFLD alone on a block (the MPM's *NONLOCAL runs it on every block, averages
+  !> a field variable over the particles, then calls call_material with field_given): the same
+  !> arguments and pieces as inside call_material; its stateNew is written to `state` (the
+  !> VUMAT's stateOld, as inside call_material) and its fields to field_new (nb, nfieldv), with
+  !> `field` (the block's, the last increment's values) as fieldNew on entry.
+  subroutine call_field(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, char_length, &
+       stress, log_strain, state, field, field_new, w)
+    type(material_t), intent(in) :: mat
+    integer, intent(in) :: nb, ncomp, nshr
+    integer, intent(in) :: elem_number(nb)
+    real(dp), intent(in) :: step_time, total_time, dt
+    real(dp), intent(in) :: char_length(nb), stress(:, :), log_strain(:, :), field(:, :)
+    real(dp), intent(inout) :: state(:, :)
+    real(dp), intent(out) :: field_new(:, :)
+    type(vumat_work_t), intent(inout) :: w
+    integer :: ns, nf, piece, i0
+
+    ns = size(state, 2)
+    nf = mat%nfieldv
+    w%field_new(1:nb, 1:nf) = field(1:nb, 1:nf)
+    piece = nb
+    if (mat%user_field_code) piece = n_vec_length
+    do i0 = 1, nb, piece
+       call call_field_piece(mat, i0, min(nb, i0 + piece - 1), i0, ncomp, nshr, elem_number, step_time, &
+            total_time, dt, char_length, stress, log_strain, state(1:nb, 1:ns), w)
+    end do
+    state(1:nb, 1:ns) = w%state_mid(1:nb, 1:ns)
+    field_new = 0
+    field_new(1:nb, 1:nf) = w%field_new(1:nb, 1:nf)
+  end subroutine call_field
+
   !> call_material for a *USER MATERIAL with a user's file loaded: the block in pieces of at most
   !> n_vec_length points (array sections: copied in and out by the compiler where they are not
   !> contiguous), stressNew, stateNew, fieldNew and the energies holding the old values on entry
   !> (a VUMAT that leaves an output alone keeps the old value, as in Abaqus).
   subroutine call_user_material(mat, nb, ncomp, nshr, elem_number, step_time, total_time, dt, &
        char_length, density, strain_inc, rel_spin, stretch_old, stretch_new, defgrad_old, &
-       defgrad_new, log_strain, stress, state, field, e_int, e_inel, w)
+       defgrad_new, log_strain, stress, state, field, e_int, e_inel, w, field_given)
     type(material_t), intent(in) :: mat
     integer, intent(in) :: nb, ncomp, nshr
     integer, intent(in) :: elem_number(nb)
@@ -177,6 +220,7 @@ contains
     real(dp), intent(in) :: log_strain(:, :)
     real(dp), intent(inout) :: stress(:, :), state(:, :), field(:, :), e_int(:), e_inel(:)
     type(vumat_work_t), intent(inout) :: w
+    real(dp), intent(in), optional :: field_given(:, :)
     procedure(), pointer :: umat
     integer :: nstatev, nfieldv, nprops, ns, nf, i0, i1, n
 
@@ -196,8 +240,12 @@ contains
        w%field_new(1:n, 1:nf) = field(i0:i1, 1:nf)
        w%e_int_new(1:n) = e_int(i0:i1)
        w%e_inel_new(1:n) = e_inel(i0:i1)
-       if (mat%user_field) call call_field_piece(mat, i0, i1, 1, ncomp, nshr, elem_number, step_time, &
-            total_time, dt, char_length, stress, log_strain, state(:, 1:ns), w)
+       if (present(field_given)) then
+          w%field_new(1:n, 1:nf) = field_given(i0:i1, 1:nf)
+       else if (mat%user_field) then
+          call call_field_piece(mat, i0, i1, 1, ncomp, nshr, elem_number, step_time, total_time, dt, &
+               char_length, stress, log_strain, state(:, 1:ns), w)
+       end if
        w%state_new(1:n, 1:ns) = w%state_mid(1:n, 1:ns)
        call umat(w%jblock, 3, nshr, nstatev, nfieldv, nprops, 0, step_time, total_time, dt, &
             mat%vumat_name, w%coord(i0:i1, :), char_length(i0:i1), mat%props, density(i0:i1), &

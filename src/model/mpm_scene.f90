@@ -74,6 +74,17 @@ module mpm_scene
      type(mpm_inflow_t) :: inflow
   end type mpm_step_t
 
+  !> *NONLOCAL: a length scale for the particles' softening (docs/nonlocal.md). Field variable
+  !> `field` of the VUSDFLD of the chosen materials is replaced, before the VUMAT reads it, by its
+  !> average over the particles of the same material within `length` (bell-shaped weight).
+  type, public :: mpm_nonlocal_t
+     logical :: on = .false.
+     real(dp) :: length = 0                 !< radius of the weight's support
+     integer :: field = 1                   !< field variable number averaged (FVn)
+     integer :: material = 0                !< index into model%materials; 0: every material with a user field
+     character(len=256) :: source = ''      !< file:line of the keyword (messages)
+  end type mpm_nonlocal_t
+
   type, public :: mpm_scene_t
      logical :: active = .false.
      integer :: ndim = 0
@@ -89,5 +100,6 @@ module mpm_scene
      !> grid over MPI ranks: replicated (every rank the whole grid) or spatial (mpm_domain)
      integer :: decomposition = decomposition_replicated
      real(dp) :: rebalance = 0.25_dp         !< spatial: re-partition when max/mean − 1 of counts exceeds it
+     type(mpm_nonlocal_t) :: nonlocal
   end type mpm_scene_t
 end module mpm_scene

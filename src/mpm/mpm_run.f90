@@ -6,6 +6,7 @@
 !>   set-up       grid, particles, walls, effects                                  (mpm_setup)
 !>   transfer     Δt; stencils, P2G, grid update, walls, G2P, MUSL remap           (mpm_musl)
 !>   stress       F, Green–Naghdi frame, VUSDFLD/VUMAT on the block                (mpm_stress_update)
+!>                with *NONLOCAL: VUSDFLD on all blocks, the average, then the VUMAT (mpm_nonlocal)
 !>   flow         particles behind walls put back, outflow, inflow                 (mpm_flow)
 !>   report       header, history rows, frames, summary                            (mpm_report)
 !> and the state they share is mpm_state.
@@ -22,9 +23,10 @@ module mpm_run
   use base_kinds, only: dp
   use error_report, only: error_t
   use model, only: model_t
-  use mpm_state, only: mpm_state_t, fx_walls, fx_outflow, fx_inflow, fx_migration
+  use mpm_state, only: mpm_state_t, fx_walls, fx_outflow, fx_inflow, fx_migration, fx_nonlocal
   use mpm_musl, only: step_gravity, musl_transfer
   use mpm_stress_update, only: stress_update
+  use mpm_nonlocal, only: nonlocal_stress_update
   use mpm_flow, only: guard_particles, outflow, inflow
   use mpm_migrate, only: domain_increment_end
   use mpm_domain, only: domain_build
@@ -54,9 +56,13 @@ contains
     s = st%step
     call step_gravity(m, st)
     call musl_transfer(m, st, fx)
-    do ib = 1, st%nblocks
-       call stress_update(m, st, fx, st%blocks(ib))
-    end do
+    if (fx%active(fx_nonlocal)) then
+       call nonlocal_stress_update(m, st, fx)
+    else
+       do ib = 1, st%nblocks
+          call stress_update(m, st, fx, st%blocks(ib))
+       end do
+    end if
     if (fx%active(fx_walls)) then
        call fx%start(fx_walls)
        call guard_particles(m%mpm%walls, st)

@@ -13,7 +13,7 @@ module mpm_setup
   use mpm_halo, only: domain_regrid
   use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
        fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_side_friction, &
-       fx_exchange, fx_migration
+       fx_exchange, fx_migration, fx_nonlocal
   use output_effects, only: effects_t
   use mpm_grid, only: grid_init
   use mpm_particles, only: particle_block_size
@@ -95,6 +95,12 @@ contains
          st%nblocks = s
       end if
     end associate
+    ! The average needs every neighbour within LENGTH on the rank: neither decomposition keeps
+    ! them there (the replicated one deals blocks out, the spatial one would need a particle
+    ! halo of width LENGTH). Refused rather than averaged over a rank's share.
+    if (m%mpm%nonlocal%on .and. st%nranks > 1) call raise_error(trim(m%mpm%nonlocal%source), 0, &
+         '*NONLOCAL is not supported with ' // trim(rank_text(st%nranks)) // ' ranks (the neighbours of a ' // &
+         'particle may be on another rank); expected a run on 1 rank')
     call setup_effects(m, st%nranks, fx)
   contains
     subroutine no_particles()
@@ -102,6 +108,12 @@ contains
            'particle centre; expected regions at least one particle spacing (CELL/PPC) wide')
     end subroutine no_particles
   end subroutine mpm_setup_run
+
+  pure function rank_text(n) result(t)
+    integer, intent(in) :: n
+    character(len=12) :: t
+    write (t, '(i0)') n
+  end function rank_text
 
   !> The walls' node lists and the mirrored symmetry planes on the rank's grid (again after a
   !> spatial decomposition changed the grid: mpm_domain).
@@ -195,6 +207,7 @@ contains
     call fx%declare(fx_side_friction, 'side friction', active=side)
     call fx%declare(fx_exchange, 'grid exchange', active=nranks > 1)
     call fx%declare(fx_migration, 'migration', active=nranks > 1 .and. m%mpm%decomposition == decomposition_spatial)
+    call fx%declare(fx_nonlocal, 'nonlocal', active=m%mpm%nonlocal%on)
   end subroutine setup_effects
 
   !> The nodes the active walls of the step constrain: local damping leaves them alone, so that

@@ -25,7 +25,8 @@ module mpm_state
   integer, parameter, public :: fx_p2g = first_technique_effect, fx_grid = fx_p2g + 1, fx_g2p = fx_p2g + 2, &
        fx_kinematics = fx_p2g + 3, fx_material = fx_p2g + 4, fx_user_field = fx_p2g + 5, fx_gravity = fx_p2g + 6, &
        fx_damping = fx_p2g + 7, fx_walls = fx_p2g + 8, fx_outflow = fx_p2g + 9, fx_inflow = fx_p2g + 10, &
-       fx_side_friction = fx_p2g + 11, fx_exchange = fx_p2g + 12, fx_migration = fx_p2g + 13
+       fx_side_friction = fx_p2g + 11, fx_exchange = fx_p2g + 12, fx_migration = fx_p2g + 13, &
+       fx_nonlocal = fx_p2g + 14
 
   !> Everything the run keeps. Per-rank partial values (sum over ranks when reported) are
   !> marked "rank"; the rest is the same on every rank.

@@ -15,24 +15,27 @@ module mpm_stress_update
   use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_transfer, only: gather_gradient
   use model_particle_fields, only: particle_temperature
-  use material_door, only: vumat_work_t, vumat_work_init, call_material
+  use material_door, only: vumat_work_t, vumat_work_init, call_material, call_field
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
   use output_effects, only: effects_t
   implicit none
   private
 
-  public :: stress_update, material_work_init, block_kinematics
+  public :: stress_update, field_update, material_work_init, block_kinematics
 
 contains
 
   !> Velocity gradient from the remapped grid velocities, F, the corotational increments, and
   !> the material call on the block (the element blocks' door).
-  subroutine stress_update(m, st, fx, b)
+  !> With field_given (*NONLOCAL: field_update ran the VUSDFLD, mpm_nonlocal averaged its
+  !> variable) the VUMAT gets field_given as fieldNew and the VUSDFLD is not called again.
+  subroutine stress_update(m, st, fx, b, field_given)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(effects_t), intent(inout) :: fx
     type(particle_block_t), intent(inout) :: b
+    real(dp), intent(in), optional :: field_given(:, :)
     integer :: nb, nd, p, iw
     real(dp) :: dt
     real(dp) :: l(b%count, st%nd, st%nd), f_mid(b%count, st%nd, st%nd), f_new(b%count, st%nd, st%nd)
@@ -51,28 +54,13 @@ contains
     call polar_rotation(nb, nd, f_new, r_new)
     call to_corotational(nb, nd, st%nc, r_mid, strain, strain_corot)
     call relative_spin(nb, nd, spin, b%rot, r_new, r_mid, rel_spin)
-    ! the work set with exactly nb rows (material_work_init)
-    iw = 1
-    if (nb /= particle_block_size) then
-       iw = 2
-       if (.not. allocated(st%work(2)%temp)) then
-          call material_work_init(st, st%work(2), nb)
-       else if (size(st%work(2)%temp) /= nb) then
-          call material_work_init(st, st%work(2), nb)
-       end if
-    end if
+    call block_work_set(m, st, b, iw)
     if (st%needs_kinematics(b%material)) then
        call vumat_defgrad(nb, nd, b%f, st%work(iw)%defgrad_old)
        call vumat_defgrad(nb, nd, f_new, st%work(iw)%defgrad_new)
        call vumat_stretch(nb, nd, b%rot, b%f, st%work(iw)%stretch_old)
        call vumat_stretch(nb, nd, r_new, f_new, st%work(iw)%stretch_new)
-       ! coordMp: the particle's position (the third column stays 0 in 2D)
-       st%work(iw)%coord(1:nb, 1:nd) = b%x(1:nb, 1:nd)
     end if
-    ! tempOld, tempNew: the material's particle temperature at t_n and t_n+1 (driver_temperature)
-    st%work(iw)%temp(1:nb) = particle_temperature(m, st%step, b%material, st%step_time, st%total_time)
-    st%work(iw)%temp_new(1:nb) = particle_temperature(m, st%step, b%material, st%step_time + dt, &
-         st%total_time + dt)
     do p = 1, nb
        if (nd == 2) then
           density(p) = f_mid(p, 1, 1) * f_mid(p, 2, 2) - f_mid(p, 1, 2) * f_mid(p, 2, 1)
@@ -92,7 +80,7 @@ contains
     call call_material(m%materials(b%material), nb, st%nc, st%nshr, b%number, st%step_time + dt, &
          st%total_time + dt, dt, char_length, density, strain_corot, rel_spin, st%work(iw)%stretch_old, &
          st%work(iw)%stretch_new, st%work(iw)%defgrad_old, st%work(iw)%defgrad_new, &
-         b%log_strain, b%stress, b%state, b%field, b%e_int, b%e_inel, st%work(iw))
+         b%log_strain, b%stress, b%state, b%field, b%e_int, b%e_inel, st%work(iw), field_given)
     call fx%stop(fx_material)
 
     call fx%start(fx_kinematics)
@@ -103,6 +91,52 @@ contains
     call to_global(nb, nd, st%nc, r_new, b%stress, b%stress_global)
     call fx%stop(fx_kinematics)
   end subroutine stress_update
+
+  !> The VUSDFLD alone on block b (*NONLOCAL, before the averaging): its state becomes the block's,
+  !> its fields go to field_new (nb, nfieldv); the same point data as inside stress_update.
+  subroutine field_update(m, st, b, field_new)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), intent(inout) :: b
+    real(dp), intent(out) :: field_new(:, :)
+    integer :: iw
+    real(dp) :: char_length(b%count)
+
+    call block_work_set(m, st, b, iw)
+    char_length = 2 * b%half
+    call call_field(m%materials(b%material), b%count, st%nc, st%nshr, b%number, st%step_time + st%dt, &
+         st%total_time + st%dt, st%dt, char_length, b%stress, b%log_strain, b%state, b%field, field_new, &
+         st%work(iw))
+  end subroutine field_update
+
+  !> The work set of block b, with exactly its count of rows (material_work_init), and the point
+  !> data the VUSDFLD and the VUMAT read from it: coordMp (the particle's position, third
+  !> column 0 in 2D; only for the materials that read it) and tempOld, tempNew (the material's
+  !> particle temperature at t_n and t_n+1, driver_temperature).
+  subroutine block_work_set(m, st, b, iw)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), intent(in) :: b
+    integer, intent(out) :: iw
+    integer :: nb
+    real(dp) :: dt
+
+    nb = b%count
+    dt = st%dt
+    iw = 1
+    if (nb /= particle_block_size) then
+       iw = 2
+       if (.not. allocated(st%work(2)%temp)) then
+          call material_work_init(st, st%work(2), nb)
+       else if (size(st%work(2)%temp) /= nb) then
+          call material_work_init(st, st%work(2), nb)
+       end if
+    end if
+    if (st%needs_kinematics(b%material)) st%work(iw)%coord(1:nb, 1:st%nd) = b%x(1:nb, 1:st%nd)
+    st%work(iw)%temp(1:nb) = particle_temperature(m, st%step, b%material, st%step_time, st%total_time)
+    st%work(iw)%temp_new(1:nb) = particle_temperature(m, st%step, b%material, st%step_time + dt, &
+         st%total_time + dt)
+  end subroutine block_work_set
 
   !> F_{n+1} = (I + L Δt) F_n, F_{n+½} = (I + ½ L Δt) F_n, the strain increment sym(L)Δt
   !> (tensor shears, Abaqus order 11 22 33 12 [23 31]) and the spin increment skw(L)Δt
