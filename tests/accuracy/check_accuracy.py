@@ -8,6 +8,12 @@ falls strictly with every refinement; the observed order of the three finest is 
 [1.7, 2.6] (both kinds are second order: docs/accuracy.md says why); and every recommendation
 is a member within its target with no member of less work also within it. Exit status 1 with the
 failed checks listed.
+
+bin-tss (a Richardson family of an MPM bin, no exact solution and no expected order) is checked
+for what the command promises instead: every member has either a T_ss (a positive multiple of the
+0.5 s window, with an MDR) or no value, no error and no MDR with the reason in `tss_status`; the
+summary extrapolates only when the three finest have a value, and recommends nothing without a
+reference.
 """
 import argparse
 import csv
@@ -48,8 +54,12 @@ def main() -> int:
     summary = json.loads(files[2].read_text())
     rows = list(csv.DictReader(files[0].open()))
     members = summary["members"]
-    check(len(rows) == len(members) >= 4, f"{len(rows)} CSV rows = {len(members)} JSON members (at least 4)")
+    check(len(rows) == len(members) >= (3 if a.kind == "bin-tss" else 4), f"{len(rows)} CSV rows = {len(members)} JSON members (at least 4)")
     members = sorted(members, key=lambda m: -m["h"])          # coarse to fine
+    if a.kind == "bin-tss":
+        check_bin_tss(summary, members, check)
+        print(f"{len(failures)} check(s) failed" if failures else "all checks passed")
+        return 1 if failures else 0
     errors = [m["error"] for m in members]
     check(all(e2 < e1 for e1, e2 in zip(errors, errors[1:])),
           "error falls with every refinement: " + ", ".join(f"h {m['h']:.4g}: {100 * m['error']:.3g} %" for m in members))
@@ -71,6 +81,28 @@ def main() -> int:
               f"{m['label']}: measured wall {m['wall']:.3g} s, CPU {m['cpu']:.3g} s, {m['increments']} increments")
     print(f"{len(failures)} check(s) failed" if failures else "all checks passed")
     return 1 if failures else 0
+
+
+def check_bin_tss(summary, members, check) -> None:
+    """The promises of bulkflow.accuracy.bin_tss: no made-up T_ss, and a summary that says so."""
+    statuses = ("reached", "not reached", "no steady regime")
+    for m in members:
+        v = m["value"]
+        if v is None:
+            check(m["tss_status"] in statuses[1:] and m["error"] is None and m["mdr"] is None,
+                  f"{m['label']}: no T_ss ({m['tss_status']}), no error, no MDR")
+        else:
+            check(m["tss_status"] == "reached" and v >= 1.0 and abs(v / 0.5 - round(v / 0.5)) < 1e-9
+                  and m["mdr"] > 0, f"{m['label']}: T_ss {v} s, a multiple of 0.5 s, MDR {m['mdr']:.4g} kg/s/m")
+        check(m["wall"] > 0 and m["increments"] > 0, f"{m['label']}: {m['increments']} increments, "
+                                                      f"{m['wall']:.3g} s wall")
+    finest3 = sorted(members, key=lambda m: m["h"])[:3]
+    if any(m["value"] is None for m in finest3):
+        check(summary["reference"] is None and all(r["label"] is None for r in summary["recommendations"]),
+              "a finest member without T_ss: no reference, no recommendation")
+    else:
+        check("reference_note" in summary or summary["reference"] is not None,
+              f"three finest with T_ss: a reference ({summary['reference']}) or the reason for none")
 
 
 if __name__ == "__main__":

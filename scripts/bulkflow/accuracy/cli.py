@@ -7,12 +7,12 @@ import argparse
 import sys
 from pathlib import Path
 
-from . import arching_cow, hopper_mdr, incline, k0_column, wave_bar
+from . import arching_cow, bin_tss, hopper_mdr, incline, k0_column, wave_bar
 from .study import resummarise, run_family
 
 KINDS = {k["name"]: k for k in (wave_bar.KIND, wave_bar.KIND_BV, k0_column.KIND, incline.KIND, hopper_mdr.KIND,
-                                 arching_cow.KIND)}
-NOT_DONE = ("bin-tss",)
+                                 arching_cow.KIND, bin_tss.KIND)}
+NOT_DONE: tuple[str, ...] = ()
 
 
 def main(argv=None) -> int:

@@ -3,6 +3,11 @@
 A kind is a dict (see wave_bar.KIND): its members (each with the size `h` and a label), a scene
 writer, a measure (the member's `value` and, for an exact reference, its relative `error`), and
 whether the reference is exact or Richardson-extrapolated from the three finest members.
+
+A measure may return `value` None: the member ran but its quantity does not exist (bin-tss: the
+run ended before the end of steady discharge). Such a member keeps its row (cost, and why, in
+the kind's own columns) with no error; it is never replaced by a number, and a Richardson
+reference is only formed when the three finest members all have a value.
 """
 from __future__ import annotations
 
@@ -40,7 +45,7 @@ def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str |
         # machine's load; the wall and CPU times are what was measured
         row["work"] = work if work is not None else timing.increments * (res.get("particles") or member["elements"])
         rows.append(row)
-        log(f"  {member['label']:<40s} value {res['value']:.6g}"
+        log(f"  {member['label']:<40s} value {_show_value(res['value'])}"
             + (f"  error {100 * res['error']:.3g} %" if res.get("error") is not None else "")
             + f"  [{timing.wall:.2f} s wall, {timing.cpu:.2f} s cpu, {timing.increments} inc]")
     summary = summarise(kind, rows)
@@ -50,6 +55,16 @@ def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str |
     return summary
 
 
+def _show_value(v) -> str:
+    return "none (not measured)" if v is None else f"{v:.6g}"
+
+
+def missing_values(rows: list[dict], key: str = "value") -> list[str]:
+    """Labels of the members without a value for `key` (None or not a number), coarse to fine."""
+    return [r["label"] for r in sorted(rows, key=lambda r: -r["h"])
+            if r.get(key) is None or not math.isfinite(r[key])]
+
+
 def resummarise(kind: dict, out: Path) -> dict:
     """Summary and outputs again from the measured rows of an earlier run's <kind>.json (no solver
     run): for a changed summary rule without repeating a long family."""
@@ -57,7 +72,8 @@ def resummarise(kind: dict, out: Path) -> dict:
     old = json.loads(Path(f"{stem}.json").read_text())
     keep = ("label", "h", "wall", "cpu", "increments", "ranks", "work", "value", "particles", "elements",
             "n", "cell", "n_arc", "tol", "no_flow", "flow", "runs", "quick_case", "sv_l2", "sv_centroid",
-            "k0", "settlement", "wall_force")
+            "k0", "settlement", "wall_force", "edge_cells", "tss_status", "tss_rule", "steady_windows",
+            "mdr", "discharged")
     rows = [{k: m[k] for k in keep if k in m} for m in old["members"]]
     if kind["reference"] == "exact":
         for r, m in zip(rows, old["members"]):
@@ -71,17 +87,22 @@ def resummarise(kind: dict, out: Path) -> dict:
 
 def also_summary(kind: dict, rows: list[dict]) -> dict:
     """Observed order and Richardson reference of the kind's secondary quantities (`also`)."""
-    h = [r["h"] for r in rows]
     out = {}
     for key, what in kind.get("also", {}).items():
-        values = [r.get(key) for r in rows]
-        if any(v is None for v in values):
+        missing = missing_values(rows, key)
+        if len(missing) == len(rows):
             continue
+        if missing_values(sorted(rows, key=lambda r: r["h"])[:3], key):
+            out[key] = {"what": what, "observed_order": math.nan, "reference": None,
+                        "note": "not measured at " + ", ".join(missing) + " (the three finest members need it)"}
+            continue
+        measured = [r for r in rows if r["label"] not in missing]     # coarser members may lack it
+        h, values = [r["h"] for r in measured], [r[key] for r in measured]
         entry = {"what": what, "observed_order": order_from_values(h, values)}
         try:
             rich = richardson(h, values)
             entry.update(reference=rich.value, uncertainty=rich.uncertainty, gci=rich.gci)
-            finest = min(rows, key=lambda r: r["h"])
+            finest = min(measured, key=lambda r: r["h"])
             entry["finest_error"] = abs(finest[key] / rich.value - 1)
         except ValueError as exc:
             entry.update(reference=None, note=str(exc))
@@ -104,17 +125,25 @@ def summarise(kind: dict, rows: list[dict]) -> dict:
         fine = sorted(rows, key=lambda r: r["h"])[:3]
         summary["monotone"] = bool(fine[0]["error"] < fine[1]["error"] < fine[2]["error"])
         summary["reference"] = kind.get("exact_value")
+    elif missing_values(sorted(rows, key=lambda r: r["h"])[:3]):
+        return _summary_with_missing(kind, rows, summary)
     else:
-        values = [r["value"] for r in rows]
+        # coarser members without a value (the three finest have one) keep no error
+        missing = missing_values(rows)
+        measured = [r for r in rows if r["label"] not in missing]
+        for r in rows:
+            if r["label"] in missing:
+                r["error"] = None
+        h, values = [r["h"] for r in measured], [r["value"] for r in measured]
         try:
             rich = richardson(h, values)
         except ValueError as exc:
             # no observed order: report against the finest member, say so, recommend nothing
             summary.update(observed_order=order_from_values(h, values), reference=None, reference_uncertainty=None,
                            gci_finest=None, reference_note=str(exc))
-            finest, second = sorted(rows, key=lambda r: r["h"])[:2]
+            finest, second = sorted(measured, key=lambda r: r["h"])[:2]
             spread = abs(second["value"] / finest["value"] - 1)
-            for r in rows:
+            for r in measured:
                 r["error"] = abs(r["value"] / finest["value"] - 1)
             summary.update(finest_error=None, finest_label=finest["label"], members=rows,
                            recommendations=[{"target": t, "label": None, "h": None, "wall": None,
@@ -127,7 +156,7 @@ def summarise(kind: dict, rows: list[dict]) -> dict:
         summary["reference"] = rich.value
         summary["reference_uncertainty"] = rich.uncertainty
         summary["gci_finest"] = rich.gci
-        for r in rows:
+        for r in measured:
             r["error"] = abs(r["value"] - rich.value) / abs(rich.value)
     finest = min(rows, key=lambda r: r["h"])
     summary["finest_error"] = finest["error"]
@@ -145,6 +174,29 @@ def summarise(kind: dict, rows: list[dict]) -> dict:
                                            "h": pick and pick["h"], "wall": pick and pick["wall"],
                                            "line": line})
     summary["members"] = rows
+    return summary
+
+
+def _summary_with_missing(kind: dict, rows: list[dict], summary: dict) -> dict:
+    """Summary of a Richardson family one of whose three finest members has no value: no order, no
+    reference, no recommendation; the members with a value are compared with the finest of them."""
+    missing = missing_values(rows)
+    note = (f"{kind['quantity']} not measured at {', '.join(missing)}: no extrapolation "
+            "(it needs a value at each of the three finest members)")
+    measured = sorted((r for r in rows if r["label"] not in missing), key=lambda r: r["h"])
+    for r in rows:
+        r["error"] = None
+    if measured and measured[0]["value"] != 0:
+        for r in measured:
+            r["error"] = abs(r["value"] / measured[0]["value"] - 1)
+    summary.update(observed_order=math.nan, reference=None, reference_uncertainty=None, gci_finest=None,
+                   reference_note=note, finest_error=None,
+                   finest_label=measured[0]["label"] if measured else None, members=rows,
+                   recommendations=[{"target": t, "label": None, "h": None, "wall": None,
+                                     "line": f"for ±{100 * t:g} % {kind['quantity']}: no reference "
+                                             f"({kind['quantity']} not measured at every one of the three "
+                                             "finest members), no recommendation"}
+                                    for t in TARGETS])
     return summary
 
 
@@ -171,8 +223,8 @@ def markdown(kind: dict, rows: list[dict], summary: dict) -> str:
              + "".join(f"{k} | " for k in also) + "increments | work | wall (s) | CPU (s) |",
              "|---|---|---|---|" + "---|" * len(also) + "---|---|---|---|"]
     for r in sorted(rows, key=lambda r: -r["h"]):
-        lines.append(f"| {r['label']} | {r['h']:.4g} | {r['value']:.6g} | {100 * r['error']:.3g} % | "
-                     + "".join(f"{r[k]:.5g} | " for k in also)
+        lines.append(f"| {r['label']} | {r['h']:.4g} | {_cell_value(r)} | {_cell_error(r.get('error'))} | "
+                     + "".join(f"{_cell(r[k])} | " for k in also)
                      + f"{r['increments']} | {r['work']:.3g} | {r['wall']:.3g} | {r['cpu']:.3g} |")
     p = summary["observed_order"]
     ref = "exact" if summary["reference_kind"] == "exact" else (
@@ -193,6 +245,21 @@ def markdown(kind: dict, rows: list[dict], summary: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _cell(v) -> str:
+    return "–" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.5g}"
+
+
+def _cell_value(r: dict) -> str:
+    """A member's value, or why it has none (the kind's `tss_status`-like column, else 'none')."""
+    if r["value"] is not None:
+        return f"{r['value']:.6g}"
+    return next((f"none ({r[k]})" for k in ("tss_status",) if r.get(k)), "none")
+
+
+def _cell_error(e) -> str:
+    return "–" if e is None else f"{100 * e:.3g} %"
+
+
 def _json_default(x):
     if isinstance(x, float) and not math.isfinite(x):
         return None
@@ -206,10 +273,19 @@ def plot(kind: dict, rows: list[dict], summary: dict, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
-    rows = sorted(rows, key=lambda r: -r["h"])
+    no_ref = summary["reference_kind"] != "exact" and summary["reference"] is None
+    # members without a value (or, with a reference, without an error) have no point to draw
+    n_all = len(rows)
+    rows = sorted((r for r in rows if r["value"] is not None and (no_ref or r.get("error") is not None)),
+                  key=lambda r: -r["h"])
+    not_drawn = f"; {n_all - len(rows)} member(s) without a value not drawn" if len(rows) < n_all else ""
+    if not rows:
+        fig.suptitle(f"{kind['name']}: no member has a value", fontsize=10)
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        return
     wall = [r["wall"] for r in rows]
     h = [r["h"] for r in rows]
-    no_ref = summary["reference_kind"] != "exact" and summary["reference"] is None
     if no_ref:
         y = [r["value"] for r in rows]
         ax1.semilogx(wall, y, "o-")
@@ -217,7 +293,7 @@ def plot(kind: dict, rows: list[dict], summary: dict, path: Path) -> None:
         for ax in (ax1, ax2):
             ax.set_ylabel(kind["quantity"])
         ax2.set_title(f"{kind['quantity']} against {kind['parameter']}: no usable observed order, "
-                      "no reference", fontsize=9)
+                      f"no reference{not_drawn}", fontsize=9)
     else:
         y = [100 * max(r["error"], 1e-12) for r in rows]
         ax1.loglog(wall, y, "o-")
@@ -230,7 +306,8 @@ def plot(kind: dict, rows: list[dict], summary: dict, path: Path) -> None:
         for ax in (ax1, ax2):
             ax.set_ylabel("relative error, %")
         ref = "exact" if kind["reference"] == "exact" else "Richardson-extrapolated"
-        ax2.set_title(f"{kind['quantity']}: error against {kind['parameter']} ({ref} reference)", fontsize=9)
+        ax2.set_title(f"{kind['quantity']}: error against {kind['parameter']} ({ref} reference){not_drawn}",
+                      fontsize=9)
     for r, w, v in zip(rows, wall, y):
         ax1.annotate(f"{kind['parameter']} {r['h']:.3g}", (w, v), textcoords="offset points", xytext=(4, 4),
                      fontsize=8)
