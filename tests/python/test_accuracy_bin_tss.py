@@ -122,8 +122,15 @@ def test_a_coarse_member_without_a_value_leaves_the_extrapolation_of_the_three_f
 
 def test_equal_t_ss_of_the_finest_members_gives_no_order_and_no_reference():
     # T_ss is a multiple of the 0.5 s window: members that agree to it show no convergence rate
-    rows = [_row("k2", 0.2, 3.5, 38.0), _row("k3", 0.1, 3.0, 51.0), _row("k4", 0.05, 3.0, 55.0)]
+    rows = [_row("k1", 0.4, None, None), _row("k2", 0.2, 3.0, 38.0), _row("k3", 0.1, 3.0, 51.0),
+            _row("k4", 0.05, 3.0, 55.0)]
     s = study.summarise(bin_tss.KIND, rows)
     assert s["reference"] is None and "no observed order" in s["reference_note"]
+    assert "values are equal" in s["reference_note"] and "oscillatory" not in s["reference_note"]
     assert all(r["label"] is None for r in s["recommendations"])
+    assert [r["error"] for r in s["members"]] == [None, 0.0, 0.0, 0.0]
+    # one repeated value is not called oscillatory either
+    rows = [_row("k2", 0.2, 3.5, 38.0), _row("k3", 0.1, 3.0, 51.0), _row("k4", 0.05, 3.0, 55.0)]
+    s = study.summarise(bin_tss.KIND, rows)
+    assert "a value repeats" in s["reference_note"]
     assert [r["error"] for r in s["members"]] == [pytest.approx(3.5 / 3.0 - 1), 0.0, 0.0]

@@ -9,11 +9,12 @@ that the discharge is steady for seconds and then ends within the run: the **ecc
 bulkflow.mpm.bin_scene with outlet b = 50 mm (the small CI bin's), 0.2 m wide, filled to 0.6 m.
 
 - eccentric: next to the smooth (7°) right wall the sand slides out at every cell; the concentric
-  half model locked in trials (3 and 5 cells across the outlet: the rate fell to a trickle with
-  most of the sand still in; docs/accuracy.md gives the numbers);
+  half model locked in trials (3 cells across the outlet: the rate fell to nothing; 5 cells: to a
+  third in 3 s, with most of the sand still in; docs/accuracy.md gives the numbers);
 - tall: in lower, wider eccentric bins (0.2 × 0.3 m, 0.3 × 0.4 m) the rate fell from the opening
-  on, with no steady part; with 0.6 m of fill in 0.2 m it holds within 10 % for 2.5 s and more at
-  5 and 7 cells across, then drops as the surface comes down (216 kg/m, 40–50 kg/s/m);
+  on, with no steady part; with 0.6 m of fill in 0.2 m (216 kg/m) it holds within 10 % from
+  window to window for 2.5 s at 5, 7 and 9 cells across (39–57 kg/s/m), then drops (at 3 cells
+  across it never settles: that member has no T_ss, docs/accuracy.md);
 - cells h = b/(2k + 1), k = 1 … 4 (`edge_cells`): the eccentric outlet is 2k + 1 cells wide with
   its inner edge on a node line for every k, so the members differ in h only, not in where the
   edge falls in a cell (mixing edge offsets makes a series jump: hopper-mdr);
@@ -117,6 +118,6 @@ KIND = {
     "members": members,
     "scene": scene,
     "measure": measure,
-    "expected_order": "about 1 if T_ss follows the MDR (T_ss ≈ live mass / MDR, hopper-mdr's order 1.3); "
-                      "the 0.5 s quantum of T_ss limits what can be observed",
+    "expected_order": "none known: T_ss moves in steps of the 0.5 s window, so an order shows only if it "
+                      "changes by whole windows between members; the MDR up to T_ss about 1-1.5 (hopper-mdr 1.3)",
 }

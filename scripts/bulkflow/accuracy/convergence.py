@@ -93,7 +93,10 @@ def richardson(h, f, order: float | None = None, safety: float = 1.25, min_order
     p = order if order is not None else order_from_values(h, f)
     if not (p > 0):
         d21, d32 = fs[1] - fs[0], fs[2] - fs[1]
-        why = ("the differences change sign (oscillatory convergence)" if d21 * d32 <= 0 else
+        why = ("the three values are equal (nothing changes with refinement at this resolution)"
+               if d21 == 0 and d32 == 0 else
+               "one difference is zero (a value repeats)" if d21 * d32 == 0 else
+               "the differences change sign (oscillatory convergence)" if d21 * d32 < 0 else
                "the differences do not shrink fast enough with refinement (not in the asymptotic range)")
         raise ValueError(f"no observed order from {_show(fs)} at h = {_show(hs)}: {why}; "
                          "refine further or give the order")
