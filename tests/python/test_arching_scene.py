@@ -114,3 +114,57 @@ def test_flow_function_variants():
     t = ArchingScene(flow="table", table=((0.0, 100.0), (1000.0, 500.0)))
     p = _props(t.material_lines())
     assert p[7] == 3 and p[15] == 2 and p[16:20] == [0.0, 100.0, 1000.0, 500.0]
+
+
+def _vumat_cohesion(props, sigma1=0.0):
+    """The cohesion our VUMAT derives from the props of a linear flow function (umat/README.md):
+    c = fc (1 - sin φ) / (2 cos φ), fc = fc0 + k σ1, φ = prop 3."""
+    phi = math.radians(props[2])
+    return (props[8] + props[9] * sigma1) * (1 - math.sin(phi)) / (2 * math.cos(phi))
+
+
+def test_dilation_angle_option():
+    assert _props(scene_from_case("B", "c0", outlet_width=0.3, n_arc=8).material_lines())[3] == 0.0
+    assert _props(scene_from_case("B", "c0", outlet_width=0.3, n_arc=8, psi=20.0).material_lines())[3] == 20.0
+
+
+@pytest.mark.parametrize("case,reading,psi", [("B", "c0", 0.0), ("polymer", "fc0", 0.0), ("A", "c0", 10.0)])
+def test_davis_flow_rule(case, reading, psi):
+    """Davis (1968): the associated material with tan φ* = η tan φ and c* = η c, η = cos ψ cos φ /
+    (1 − sin ψ sin φ), at every consolidation stress of the flow function."""
+    s = scene_from_case(case, reading, outlet_width=0.3, n_arc=8, psi=psi)
+    d = dataclasses.replace(s, flow_rule="davis")
+    p0, p1 = _props(s.material_lines()), _props(d.material_lines())
+    f, q = math.radians(s.phi), math.radians(psi)
+    eta = math.cos(q) * math.cos(f) / (1 - math.sin(q) * math.sin(f))
+    assert p1[2] == p1[3], "Davis's material is associated"
+    assert math.isclose(math.tan(math.radians(p1[2])), eta * math.tan(f), rel_tol=1e-7)
+    assert p1[2] < s.phi
+    for sigma1 in (0.0, 1000.0, 5000.0):
+        assert math.isclose(_vumat_cohesion(p1, sigma1), eta * _vumat_cohesion(p0, sigma1), rel_tol=1e-7)
+    # the scene keeps the material's own angles (the theories use them)
+    assert d.phi == s.phi and d.psi == psi
+
+
+def test_davis_of_an_associated_material_is_the_material():
+    s = scene_from_case("B", "c0", outlet_width=0.3, n_arc=8, psi=20.0)
+    a, b = _props(s.material_lines()), _props(dataclasses.replace(s, flow_rule="davis").material_lines())
+    assert np.allclose(a, b, rtol=1e-7)
+
+
+def test_davis_rejects_the_bilinear_flow_function():
+    s = scene_from_case("sic", "c0", outlet_width=0.15, n_arc=8, flow="bilinear", flow_rule="davis")
+    with pytest.raises(ValueError):
+        s.material_lines()
+
+
+def test_hourglass_and_bulk_viscosity_options():
+    s = scene_from_case("B", "c0", outlet_width=0.3, n_arc=8)
+    lines = s.inp_text().splitlines()
+    assert "*SOLID SECTION, ELSET=POWDER, MATERIAL=MC-POWDER" in lines and "*SECTION CONTROLS" not in s.inp_text()
+    assert lines[lines.index("*BULK VISCOSITY") + 1] == "0.06, 1.2"
+    t = dataclasses.replace(s, hourglass="stiffness", hourglass_scale=2.0, bulk_viscosity=(0.0, 0.0)).inp_text()
+    lines = t.splitlines()
+    i = lines.index("*SECTION CONTROLS, NAME=HG, HOURGLASS=STIFFNESS")
+    assert lines[i + 1] == "2" and lines[i + 2] == "*SOLID SECTION, ELSET=POWDER, MATERIAL=MC-POWDER, CONTROLS=HG"
+    assert lines[lines.index("*BULK VISCOSITY") + 1] == "0, 0"

@@ -104,6 +104,11 @@ class ArchingScene:
     poisson: float = 0.2
     phi: float = 20.0
     phi_w: float = 0.0
+    psi: float = 0.0                 #: dilation angle (deg), 0 <= psi <= phi; the thesis's ch. 6 material: 0
+    #: "nonassociated": the VUMAT gets φ, ψ and the flow function as given (the thesis); "davis": it
+    #: gets the associated material of Davis (1968) with the same collapse strength, ψ* = φ*,
+    #: tan φ* = η tan φ, c* = η c, η = cos ψ cos φ / (1 − sin ψ sin φ) (README "Mesh dependence")
+    flow_rule: str = "nonassociated"
     flow: str = "linear"             #: "linear", "bilinear" (thesis §6.5.4) or "table"
     fc0: float = 2000.0              #: unconfined yield strength at σ1 = 0 (linear/bilinear)
     k: float = 0.0                   #: flow-function slope
@@ -118,6 +123,9 @@ class ArchingScene:
     slide: float = 0.02
     t_open: float = 1.0              #: longest opening step (s); the stop condition ends it earlier
     mass_scaling_dt_factor: float = 4.0   #: steps 1-2: BELOW MIN to this × the smallest increment; ≤ 1: none
+    bulk_viscosity: tuple = (0.06, 1.2)   #: *BULK VISCOSITY b1, b2 of every step (the solver's defaults)
+    hourglass: str = "viscous"       #: CPE4R hourglass form, "viscous" (the solver's default) or "stiffness"
+    hourglass_scale: float = 1.0     #: hourglass coefficient x the solver's default for the form
     dt_scale: float = 1.0            #: *DYNAMIC SCALE FACTOR of every step (1: none written); perturbs the increments
     stop: bool = True                #: *STOP CONDITION in the opening step
     #: FLOW rule: "physical" (u_max > flow_width_fraction × B, the same on every mesh) or
@@ -214,11 +222,29 @@ class ArchingScene:
         return self.n_arc * self.n_radial()
 
     # ---- material ---------------------------------------------------------------------------
+    def vumat_strength(self) -> tuple[float, float, float]:
+        """(φ, ψ, f) the VUMAT gets: the angles (deg) and the factor on fc(σ1). "nonassociated": φ, ψ,
+        1. "davis": φ* = ψ* with tan φ* = η tan φ, and f such that the VUMAT's cohesion
+        fc (1 − sin φ*)/(2 cos φ*) (thesis eq. 6.9 with φ*) is η times that of the material."""
+        if self.flow_rule == "nonassociated":
+            return self.phi, self.psi, 1.0
+        if self.flow_rule != "davis":
+            raise ValueError(f"flow_rule {self.flow_rule!r}: expected nonassociated or davis")
+        if self.flow == "bilinear":
+            raise ValueError("flow_rule davis scales fc(σ1) by a factor; the bilinear flow function's first leg "
+                             "does not scale with fc0 and k: give it as a table")
+        f, p = math.radians(self.phi), math.radians(self.psi)
+        eta = math.cos(p) * math.cos(f) / (1.0 - math.sin(p) * math.sin(f))
+        fs = math.atan(eta * math.tan(f))
+        scale = eta * (1.0 - math.sin(f)) / math.cos(f) * math.cos(fs) / (1.0 - math.sin(fs))
+        return math.degrees(fs), math.degrees(fs), scale
+
     def material_lines(self) -> list[str]:
         kind = {"linear": 1, "bilinear": 2, "table": 3}[self.flow]
-        table = list(self.table) if self.flow == "table" else []
-        props = [self.young, self.poisson, self.phi, 0.0, 0.0, 0, 0,                  # 1-7
-                 kind, self.fc0, self.k, self.freeze_time(), 0,                         # 8-12
+        phi, psi, f = self.vumat_strength()
+        table = [(s1, f * fc) for s1, fc in self.table] if self.flow == "table" else []
+        props = [self.young, self.poisson, phi, psi, 0.0, 0, 0,                             # 1-7
+                 kind, f * self.fc0, f * self.k, self.freeze_time(), 0,                 # 8-12
                  0, 0, 0, len(table)]                                                   # 13-16
         for s1, fc in table:
             props += [s1, fc]
@@ -248,11 +274,16 @@ class ArchingScene:
         L += [f"{i + 1}, " + ", ".join(str(v + 1) for v in e) for i, e in enumerate(elems)]
         L += nset("AXIS", sets["n_axis"]) + nset("OUTLETN", sets["n_bottom"])
         L += elset("WALLE", sets["e_wall"]) + elset("BOTTOME", sets["e_bottom"])
-        L += ["*SOLID SECTION, ELSET=POWDER, MATERIAL=MC-POWDER", "1."]
+        if self.hourglass == "viscous" and self.hourglass_scale == 1.0:
+            L += ["*SOLID SECTION, ELSET=POWDER, MATERIAL=MC-POWDER", "1."]
+        else:
+            L += [f"*SECTION CONTROLS, NAME=HG, HOURGLASS={self.hourglass.upper()}", fmt(self.hourglass_scale),
+                  "*SOLID SECTION, ELSET=POWDER, MATERIAL=MC-POWDER, CONTROLS=HG", "1."]
         L += self.material_lines()
         L += ["*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME", f"0., 0., {fmt(self.t_gravity)}, 1."]
         if self.state == "passive":
             L += ["*AMPLITUDE, NAME=SLIDE, DEFINITION=SMOOTH STEP, TIME=STEP TIME", f"0., 0., {fmt(self.t_slide)}, 1."]
+
         L += ["*BOUNDARY", "AXIS, XSYMM",
               "*SURFACE, TYPE=ELEMENT, NAME=POWDER_WALL", "WALLE, S2",
               "*SURFACE, TYPE=ELEMENT, NAME=POWDER_OUTLET", "BOTTOME, S1"]
@@ -283,7 +314,8 @@ class ArchingScene:
         outputs += [f"*OUTPUT, HISTORY, NUMBER INTERVAL={self.history_points}",
                     "*ENERGY OUTPUT, VARIABLE=PRESELECT", "*NODE OUTPUT, NSET=OUTLETN", "U2"]
         L += ["*STEP, NAME=GRAVITY, NLGEOM=YES", "Gravity by smooth step, outlet closed",
-              self.dynamic_line(), f", {fmt(self.t_gravity)}", "*BULK VISCOSITY", "0.06, 1.2"]
+              self.dynamic_line(), f", {fmt(self.t_gravity)}", "*BULK VISCOSITY",
+              ", ".join(fmt(v) for v in self.bulk_viscosity)]
         if ms > 0:
             L += [f"*FIXED MASS SCALING, DT={ms:.6g}, TYPE=BELOW MIN"]
         L += ["*DLOAD, AMPLITUDE=RAMP", f"POWDER, GRAV, {fmt(self.gravity)}, 0., -1."]
@@ -378,6 +410,9 @@ def add_scene_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--poisson", type=float, default=d.poisson)
     g.add_argument("--phi", type=float)
     g.add_argument("--phi-w", type=float)
+    g.add_argument("--psi", type=float, default=d.psi, help="dilation angle (deg), 0 (the thesis) .. phi")
+    g.add_argument("--flow-rule", choices=["nonassociated", "davis"], default=d.flow_rule,
+                   help="davis: the VUMAT gets Davis's associated material of equal strength (phi*, c*)")
     g.add_argument("--fc0", type=float, help="unconfined yield strength at zero consolidation (Pa)")
     g.add_argument("--c0", type=float, help="cohesion at zero consolidation (Pa), converted by eq. 6.9")
     g.add_argument("--k", type=float)
@@ -428,7 +463,7 @@ def scene_from_args(a, outlet_width: float | None = None) -> ArchingScene:
                                     fc0=base.get("fc0", d.fc0), theta=base.get("theta", d.theta),
                                     height=base.get("height", d.height)))
     s = ArchingScene(**base, arch=a.arch, beta=beta, n_arc=a.n_arc, young=a.young, poisson=a.poisson,
-                     flow=a.flow, table=table, state=a.state, t_gravity=a.t_gravity, t_slide=a.t_slide,
+                     psi=a.psi, flow_rule=a.flow_rule, flow=a.flow, table=table, state=a.state, t_gravity=a.t_gravity, t_slide=a.t_slide,
                      slide=a.slide, t_open=a.t_open, mass_scaling_dt_factor=a.mass_scaling,
                      stop=not a.no_stop, criterion=a.criterion, flow_width_fraction=a.flow_width_fraction,
                      hold=a.hold, ke_fraction=a.ke_fraction, field_frames=a.field_frames)

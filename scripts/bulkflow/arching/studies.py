@@ -4,6 +4,7 @@
     bulkflow-arching-study parametric  [--quick]   # θ, φw, φ, k around Case A at 2 m (Fig. 6.9)
     bulkflow-arching-study mesh        [--quick]   # elements along the outlet vs COW and wall time (Fig. 6.4)
     bulkflow-arching-study convergence [--n-arcs 16,30,60]  # COW vs mesh, physical vs half-element FLOW rule
+    bulkflow-arching-study meshdiag [--variants assoc,davis]  # why the COW drifts with the mesh (issue 21)
     bulkflow-arching-study elastic     [--quick]   # E and ν (Fig. 6.6)
     bulkflow-arching-study stress      [--quick]   # principal stresses along the wall vs Enstad (Fig. 6.7)
     bulkflow-arching-study powders     [--quick]   # Eckhoff & Leversen powders, both c0 readings, linear/bilinear (Table 6.3)
@@ -470,10 +471,97 @@ def convergence_table(rows: list[dict]) -> str:
                      f"{r['wall']:.0f} | {r['wall_per_run']:.1f} | {float(r.get('cpu_per_run', 'nan')):.1f} |")
     return "\n".join(lines)
 
+#: meshdiag: the variants of the mesh-dependence diagnosis (issue 21 point 1), each removing or
+#: changing one candidate cause of the drift of the COW with the mesh (README "Mesh dependence:
+#: diagnosis"); scene fields overridden on top of Case B. "assoc" sets ψ = φ of the case.
+MESHDIAG_VARIANTS = {
+    "baseline": {},
+    "ms1": dict(mass_scaling_dt_factor=1.0),              # (c) no mass scaling in steps 1-2
+    "assoc": dict(psi="phi"),                             # (b) associated flow, ψ = φ
+    "psi10": dict(psi=10.0),                              # (b) half way: ψ = 10°
+    "davis": dict(flow_rule="davis"),                     # (b) Davis's associated material of equal strength
+    "nobv": dict(bulk_viscosity=(0.0, 0.0)),              # bulk viscosity (∝ element size) off
+    "hgstiff": dict(hourglass="stiffness"),               # (e) stiffness instead of viscous hourglass control
+    "hg10": dict(hourglass_scale=10.0),                   # (e) viscous hourglass control x 10
+    "hold": dict(hold=0.15, min_open_time=0.15),          # (f) ARREST windows 3 x longer
+}
+
+
+def mesh_sequence(srch: Search, ns: list[int], start: float, margin: float, tol: float, log=print) -> list[dict]:
+    """The COW on each mesh of `ns` (coarsest first): bracket from `start` by factors of 1.3 and
+    bisect on the first mesh; on each finer one refine the previous interval widened by `margin`.
+    One dict per mesh: interval, runs on that mesh, their wall and CPU time."""
+    rows, lo, hi = [], None, None
+    for n in ns:
+        k0 = len(srch.runs)
+        if lo is not None and hi is not None:
+            lo, hi = refine(srch, lo - margin, hi + margin, n, tol, 0.5 * (lo + hi))
+        else:
+            lo, hi = srch.bracket(min(start, 0.9 * srch.max_width()), n)
+            if lo is not None and hi is not None:
+                lo, hi = srch.bisect(lo, hi, n, tol)
+        runs = srch.runs[k0:]
+        rows.append(dict(n_arc=n, fem_no_flow=lo, fem_flow=hi, runs=len(runs), wall=sum(r.wall for r in runs),
+                         cpu=sum(r.cpu for r in runs)))
+        log(f"  -> n_arc {n}: {_cm(lo):.2f} .. {_cm(hi):.2f} cm, {len(runs)} runs, {rows[-1]['wall']:.0f} s")
+    return rows
+
+
+def study_meshdiag(a) -> Study:
+    """Mesh-dependence diagnosis (issue 21 point 1): the COW of Case B (--cases B, c0 reading) or the
+    polymer (--cases polymer, fc0 reading), 1 m unless --height, on the meshes of --n-arcs for each
+    variant of --variants (MESHDIAG_VARIANTS), to --tol-mm. Writes meshdiag.csv,
+    meshdiag_table.txt and meshdiag.json (every trial)."""
+    st = Study("meshdiag", a.out, a.np)
+    ns = [int(v) for v in a.n_arcs.split(",")]
+    h = a.height or 1.0
+    case = a.cases if a.cases in ("B", "polymer") else "B"
+    reading = "fc0" if case == "polymer" else "c0"
+    names = a.variants.split(",") if a.variants else list(MESHDIAG_VARIANTS)
+    rows = []
+    for name in names:
+        over = dict(MESHDIAG_VARIANTS[name])
+        sc = scene_from_case(case, reading, height=h, n_arc=ns[0], field_frames=0)
+        if over.get("psi") == "phi":
+            over["psi"] = sc.phi
+        sc = replace(sc, **over)
+        print(f"meshdiag: variant {name} {over}", flush=True)
+        srch = Search(sc, a.out / "runs" / name, a.np, lambda m: print(m, flush=True))
+        for r in mesh_sequence(srch, ns, a.start, a.margin, a.tol_mm * 1e-3):
+            rows.append(dict(variant=name, case=case, overrides=json.dumps(over), height=h, **r))
+        st.results.append(dict(variant=name, overrides=over, runs=[x.as_dict() for x in srch.runs]))
+        _save_meshdiag(a.out, rows)
+        (a.out / "meshdiag.json").write_text(json.dumps(dict(rows=rows, searches=st.results), default=str))
+    print(meshdiag_table(rows))
+    return st
+
+
+def _save_meshdiag(out: Path, rows: list[dict]) -> None:
+    with open(out / "meshdiag.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    (out / "meshdiag_table.txt").write_text(meshdiag_table(rows) + "\n")
+
+
+def meshdiag_table(rows: list[dict]) -> str:
+    """Markdown table: per variant and mesh, the interval, the shift from the previous mesh, the cost."""
+    lines = ["| variant | n_arc | COW no flow .. flow (cm) | shift from the previous mesh (mm) | runs | wall (s) |",
+             "|---|---|---|---|---|---|"]
+    prev = {}
+    for r in rows:
+        lo, hi = r["fem_no_flow"], r["fem_flow"]
+        mid = 0.5 * (lo + hi) if lo and hi else None
+        shift = f"{(mid - prev[r['variant']]) * 1000:+.1f}" if mid is not None and prev.get(r["variant"]) else "—"
+        prev[r["variant"]] = mid
+        lines.append(f"| {r['variant']} | {r['n_arc']} | {_cm(lo):.2f} .. {_cm(hi):.2f} | {shift} | {r['runs']} | "
+                     f"{r['wall']:.0f} |")
+    return "\n".join(lines)
+
 
 STUDIES = dict(height=study_height, parametric=study_parametric, mesh=study_mesh, elastic=study_elastic,
                stress=study_stress, powders=study_powders, benchmark=study_benchmark, cost=study_cost,
-               convergence=study_convergence)
+               convergence=study_convergence, meshdiag=study_meshdiag)
 
 
 def main(argv=None) -> int:
@@ -489,9 +577,12 @@ def main(argv=None) -> int:
     p.add_argument("--t-open", type=float, default=0.5, help="cost: the opening step without early stop (s)")
     p.add_argument("--n-arcs", default="16,30,60", help="convergence: the meshes, coarsest first")
     p.add_argument("--criteria", default="", help="convergence: FLOW criteria (default: physical,half-element)")
-    p.add_argument("--cases", default="B,polymer", help="convergence: B and/or polymer")
+    p.add_argument("--cases", default="B,polymer", help="convergence: B and/or polymer; meshdiag: B (default) or polymer")
     p.add_argument("--margin", type=float, default=0.004,
                    help="convergence: the previous mesh's interval widened by this on both sides (m)")
+    p.add_argument("--variants", default="", help="meshdiag: comma-separated variants (default: all)")
+    p.add_argument("--tol-mm", type=float, default=4.0, help="meshdiag: interval width (mm)")
+    p.add_argument("--start", type=float, default=0.37, help="meshdiag: first width tried on the first mesh (m)")
     p.add_argument("--quick-skip-enstad", action="store_true", help="height: skip the Enstad-arch variant")
     p.add_argument("--criterion", choices=CRITERIA, default=None,
                    help="FLOW criterion of the studies (default: the generator's, physical); convergence: --criteria")
