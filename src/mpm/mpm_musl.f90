@@ -15,7 +15,8 @@ module mpm_musl
   use mpm_grid, only: grid_sum_length, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_shape, only: block_stencil
-  use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles
+  use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles, &
+       scatter_particles_3d_packed, gather_velocity_3d_packed, remap_particles_3d, pack_velocities, unpack_grid_sums
   use mpm_sort, only: sort_due, sort_blocks
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
   use mpm_setup, only: mark_wall_nodes
@@ -94,20 +95,41 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(effects_t), intent(inout) :: fx
-    integer :: ib, k, s
+    integer :: ib, k, s, lanes
     real(dp) :: e_walls0, e_damping0
+    logical :: packed, packed_sums
 
     s = st%step
     e_walls0 = st%e_walls
     e_damping0 = st%e_damping
+    ! 3D uGIMP: the vectorised kernels on packed node records (mpm_transfer); with SORT > 0 the
+    ! P2G and G2P too (8 lanes), else the gradient gather only (4 lanes)
+    packed = st%nd == 3 .and. st%nsup == 3
+    packed_sums = packed .and. m%mpm%steps(s)%sort > 0
+    if (packed) then
+       lanes = merge(8, 4, packed_sums)
+       if (allocated(st%gpack)) then
+          if (size(st%gpack, 1) /= lanes .or. size(st%gpack, 2) /= st%g%nn) deallocate (st%gpack)
+       end if
+       if (.not. allocated(st%gpack)) allocate (st%gpack(lanes, st%g%nn))
+    end if
     call fx%start(fx_p2g)
-    call grid_reset_sums(st%g)
+    if (packed_sums) then
+       call grid_clear(8 * st%g%nn, st%gpack)
+    else
+       call grid_reset_sums(st%g)
+    end if
     ! *MPM CONTROLS, SORT=n: particles in cell order, transfers particle by particle (mpm_sort)
     if (sort_due(m%mpm%steps(s)%sort, st%increment)) &
          call sort_blocks(st%blocks, st%nblocks, st%nd, st%g%lo, st%g%h, st%g%n)
     do ib = 1, st%nblocks
        call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
-       if (m%mpm%steps(s)%sort > 0) then
+       if (packed_sums) then
+          associate (b => st%blocks(ib))
+            call scatter_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+                 b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%gpack)
+          end associate
+       else if (m%mpm%steps(s)%sort > 0) then
           associate (b => st%blocks(ib))
             call scatter_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
                  b%w1, b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%g%mass, st%g%mom, st%g%force)
@@ -116,6 +138,7 @@ contains
           call p2g(st, st%blocks(ib))
        end if
     end do
+    if (packed_sums) call unpack_grid_sums(st%g%nn, st%gpack, st%g%mass, st%g%mom, st%g%force)
     call exchange_grid_sums(st, fx, fx_p2g, .true.)
     st%g%mass_own = st%g%mass
     st%wall_force = 0
@@ -170,8 +193,16 @@ contains
 
     call fx%start(fx_g2p)
     call grid_clear(st%nd * st%g%nn, st%g%mom)
+    if (packed_sums) call pack_velocities(st%g%nn, 8, st%g%v_new, st%g%v_old, st%gpack)
     do ib = 1, st%nblocks
-       if (m%mpm%steps(s)%sort > 0) then
+       if (packed_sums) then
+          associate (b => st%blocks(ib))
+            call gather_velocity_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+                 st%gpack, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%w_external)
+            call remap_particles_3d(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%mass, b%v, &
+                 st%g%mom)
+          end associate
+       else if (m%mpm%steps(s)%sort > 0) then
           associate (b => st%blocks(ib))
             call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
                  st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%g%mom, &
@@ -211,6 +242,8 @@ contains
        end do
        call fx%stop(fx_walls)
     end if
+    ! the remapped velocity for the stress update's gradient gather (mpm_stress_update)
+    if (packed) call pack_velocities(st%g%nn, 4, st%g%v_new, st%g%v_new, st%gpack)
   end subroutine musl_transfer
 
   !> The rigid surfaces at t_n+1: their reference nodes' velocity over the increment and
