@@ -16,7 +16,8 @@ module mpm_musl
   use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_shape, only: block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles, &
-       scatter_particles_3d_packed, gather_velocity_3d_packed, remap_particles_3d, pack_velocities, unpack_grid_sums
+       scatter_particles_3d_packed, gather_velocity_3d_packed, remap_particles_3d_packed, unpack_momentum, &
+       pack_velocities, unpack_grid_sums
   use mpm_sort, only: sort_due, sort_blocks
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
   use mpm_setup, only: mark_wall_nodes
@@ -192,26 +193,38 @@ contains
     call side_friction_work(m, st, fx)    ! its work on the velocity the walls left
 
     call fx%start(fx_g2p)
-    call grid_clear(st%nd * st%g%nn, st%g%mom)
-    if (packed_sums) call pack_velocities(st%g%nn, 8, st%g%v_new, st%g%v_old, st%gpack)
-    do ib = 1, st%nblocks
-       if (packed_sums) then
+    if (packed_sums) then
+       ! every block's gather (v_new, v_old packed), then every block's remap into the records'
+       ! first 4 nn values: each node's sum in the particle order of the one-pass loop
+       call pack_velocities(st%g%nn, 8, st%g%v_new, st%g%v_old, st%gpack)
+       do ib = 1, st%nblocks
           associate (b => st%blocks(ib))
             call gather_velocity_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
                  st%gpack, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%w_external)
-            call remap_particles_3d(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%mass, b%v, &
-                 st%g%mom)
           end associate
-       else if (m%mpm%steps(s)%sort > 0) then
+       end do
+       call grid_clear(4 * st%g%nn, st%gpack)
+       do ib = 1, st%nblocks
           associate (b => st%blocks(ib))
-            call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
-                 st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%g%mom, &
-                 st%w_external)
+            call remap_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+                 b%mass, b%v, st%gpack)
           end associate
-       else
-          call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
-       end if
-    end do
+       end do
+       call unpack_momentum(st%g%nn, st%gpack, st%g%mom)
+    else
+       call grid_clear(st%nd * st%g%nn, st%g%mom)
+       do ib = 1, st%nblocks
+          if (m%mpm%steps(s)%sort > 0) then
+             associate (b => st%blocks(ib))
+               call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, &
+                    st%g%mom, st%w_external)
+             end associate
+          else
+             call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
+          end if
+       end do
+    end if
     call exchange_grid_sums(st, fx, fx_g2p, .false.)
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)

@@ -30,7 +30,7 @@ module mpm_transfer
   public :: scatter_p2g, gather_velocity, scatter_momentum, gather_gradient
   public :: scatter_particles, g2p_particles
   public :: scatter_particles_3d_packed, gather_velocity_3d_packed, gather_gradient_3d_packed
-  public :: remap_particles_3d, pack_velocities, unpack_grid_sums
+  public :: remap_particles_3d_packed, unpack_momentum, pack_velocities, unpack_grid_sums
 
 contains
 
@@ -331,15 +331,15 @@ contains
     end do
   end subroutine gather_velocity_3d_packed
 
-  !> The remap pass of g2p_particles for 3D uGIMP (mpm_transfer_g2p_particles.inc's second loop):
-  !> gmom += Σ S m v, particle by particle.
-  pure subroutine remap_particles_3d(nb, nn, nx, nxy, corner, w1, mp, v, gmom)
+  !> The remap pass of g2p_particles for 3D uGIMP (mpm_transfer_g2p_particles.inc's second loop)
+  !> into packed momentum records gm(4, nn) (lane 4: 0): gm += Σ S m v, particle by particle.
+  pure subroutine remap_particles_3d_packed(nb, nn, nx, nxy, corner, w1, mp, v, gm)
     integer, parameter :: nsup = 3, nd = 3
     integer, intent(in) :: nb, nn, nx, nxy
     integer, intent(in) :: corner(nb)
     real(dp), intent(in) :: w1(nb, nsup, nd), mp(nb), v(nb, nd)
-    real(dp), intent(inout) :: gmom(nd, nn)
-    real(dp) :: mv(3), ws
+    real(dp), intent(inout) :: gm(4, nn)
+    real(dp) :: mv(4), ws
     integer(int64) :: row
     integer :: a, b, c, p, k
 
@@ -347,20 +347,36 @@ contains
        do k = 1, nd
           mv(k) = mp(p) * v(p, k)
        end do
+       mv(4) = 0
        do c = 1, nsup
           do b = 1, nsup
              row = int(corner(p), int64) + int(nx, int64) * (b - 1) + int(nxy, int64) * (c - 1)
              do a = 1, nsup
                 ws = w1(p, a, 1) * w1(p, b, 2)
                 ws = ws * w1(p, c, 3)
-                do k = 1, nd
-                   gmom(k, row + (a - 1)) = gmom(k, row + (a - 1)) + ws * mv(k)
+                !GCC$ unroll 1
+                do k = 1, 4
+                   gm(k, row + (a - 1)) = gm(k, row + (a - 1)) + ws * mv(k)
                 end do
              end do
           end do
        end do
     end do
-  end subroutine remap_particles_3d
+  end subroutine remap_particles_3d_packed
+
+  !> The momentum from packed records: mom(:, i) = gm(1:3, i) for nodes 1..nn.
+  pure subroutine unpack_momentum(nn, gm, gmom)
+    integer, intent(in) :: nn
+    real(dp), intent(in) :: gm(4, nn)
+    real(dp), intent(out) :: gmom(3, nn)
+    integer :: i
+
+    do i = 1, nn
+       gmom(1, i) = gm(1, i)
+       gmom(2, i) = gm(2, i)
+       gmom(3, i) = gm(3, i)
+    end do
+  end subroutine unpack_momentum
 
   !> gather_gradient for 3D uGIMP on packed velocity records gv(4, nn) (lane 4: 0).
   pure subroutine gather_gradient_3d_packed(nb, nn, nx, nxy, corner, w1, dw1, gv, l)
