@@ -454,10 +454,16 @@ contains
     do i = 1, nn
        active(i) = mass(i) > cutoff
        if (.not. active(i)) then
-          do k = 1, nd
-             v_old(k, i) = 0
-             v_new(k, i) = 0
-          end do
+          ! component by component, not a loop to nd: gcc made that loop two memset calls per
+          ! inactive node (issue 19)
+          v_old(1, i) = 0
+          v_old(2, i) = 0
+          v_new(1, i) = 0
+          v_new(2, i) = 0
+          if (nd == 3) then
+             v_old(nd, i) = 0
+             v_new(nd, i) = 0
+          end if
           cycle
        end if
        do k = 1, nd
