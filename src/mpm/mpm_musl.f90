@@ -17,7 +17,8 @@ module mpm_musl
   use mpm_shape, only: block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles, &
        scatter_particles_3d_packed, gather_velocity_3d_packed, remap_particles_3d_packed, unpack_momentum, &
-       pack_velocities, unpack_grid_sums
+       pack_velocities, unpack_grid_sums, scatter_p2g_3d_packed, gather_velocity_3d_packed_pic, &
+       scatter_momentum_3d_packed
   use mpm_sort, only: sort_due, sort_blocks
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
   use mpm_setup, only: mark_wall_nodes
@@ -96,26 +97,25 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(effects_t), intent(inout) :: fx
-    integer :: ib, k, s, lanes
+    integer :: ib, k, s
     real(dp) :: e_walls0, e_damping0
-    logical :: packed, packed_sums
+    logical :: packed, sorted
 
     s = st%step
     e_walls0 = st%e_walls
     e_damping0 = st%e_damping
-    ! 3D uGIMP: the vectorised kernels on packed node records (mpm_transfer); with SORT > 0 the
-    ! P2G and G2P too (8 lanes), else the gradient gather only (4 lanes)
+    ! 3D uGIMP: the P2G, G2P + remap and gradient gather on packed node records (mpm_transfer),
+    ! vectorised; the same sums in the same order
     packed = st%nd == 3 .and. st%nsup == 3
-    packed_sums = packed .and. m%mpm%steps(s)%sort > 0
+    sorted = m%mpm%steps(s)%sort > 0
     if (packed) then
-       lanes = merge(8, 4, packed_sums)
        if (allocated(st%gpack)) then
-          if (size(st%gpack, 1) /= lanes .or. size(st%gpack, 2) /= st%g%nn) deallocate (st%gpack)
+          if (size(st%gpack, 2) /= st%g%nn) deallocate (st%gpack)
        end if
-       if (.not. allocated(st%gpack)) allocate (st%gpack(lanes, st%g%nn))
+       if (.not. allocated(st%gpack)) allocate (st%gpack(8, st%g%nn))
     end if
     call fx%start(fx_p2g)
-    if (packed_sums) then
+    if (packed) then
        call grid_clear(8 * st%g%nn, st%gpack)
     else
        call grid_reset_sums(st%g)
@@ -125,7 +125,7 @@ contains
          call sort_blocks(st%blocks, st%nblocks, st%nd, st%g%lo, st%g%h, st%g%n)
     do ib = 1, st%nblocks
        call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
-       if (packed_sums) then
+       if (packed .and. sorted) then
           associate (b => st%blocks(ib))
             call scatter_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
                  b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%gpack)
@@ -136,10 +136,10 @@ contains
                  b%w1, b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%g%mass, st%g%mom, st%g%force)
           end associate
        else
-          call p2g(st, st%blocks(ib))
+          call p2g(st, st%blocks(ib), packed)
        end if
     end do
-    if (packed_sums) call unpack_grid_sums(st%g%nn, st%gpack, st%g%mass, st%g%mom, st%g%force)
+    if (packed) call unpack_grid_sums(st%g%nn, st%gpack, st%g%mass, st%g%mom, st%g%force)
     call exchange_grid_sums(st, fx, fx_p2g, .true.)
     st%g%mass_own = st%g%mass
     st%wall_force = 0
@@ -193,21 +193,30 @@ contains
     call side_friction_work(m, st, fx)    ! its work on the velocity the walls left
 
     call fx%start(fx_g2p)
-    if (packed_sums) then
-       ! every block's gather (v_new, v_old packed), then every block's remap into the records'
-       ! first 4 nn values: each node's sum in the particle order of the one-pass loop
+    if (packed) then
+       ! every block's gather and particle update (v_new, v_old packed), then every block's remap
+       ! into the records' first 4 nn values: each node's sum in the particle order of the
+       ! block-by-block loop below
        call pack_velocities(st%g%nn, 8, st%g%v_new, st%g%v_old, st%gpack)
        do ib = 1, st%nblocks
           associate (b => st%blocks(ib))
-            call gather_velocity_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
-                 st%gpack, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%w_external)
+            if (sorted) then
+               call gather_velocity_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, st%gpack, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%w_external)
+            else
+               call g2p_packed(st, b, m%mpm%steps(s)%flip)
+            end if
           end associate
        end do
        call grid_clear(4 * st%g%nn, st%gpack)
        do ib = 1, st%nblocks
           associate (b => st%blocks(ib))
-            call remap_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
-                 b%mass, b%v, st%gpack)
+            if (sorted) then
+               call remap_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, b%mass, b%v, st%gpack)
+            else
+               call remap_packed(st, b)
+            end if
           end associate
        end do
        call unpack_momentum(st%g%nn, st%gpack, st%g%mom)
@@ -396,14 +405,26 @@ contains
   !> The factors' work arrays are fixed-size locals of particle_block_size rows' room, seen by
   !> p2g_factors and the scatter as (count, ·) arrays (sequence association): as automatic arrays
   !> of b%count rows gfortran allocated them on the heap per block and increment (issue 19).
-  subroutine p2g(st, b)
+  !> packed present and true (3D uGIMP): the sums go to st%gpack's records
+  !> (scatter_p2g_3d_packed), the caller unpacks them.
+  subroutine p2g(st, b, packed)
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(in) :: b
+    logical, intent(in), optional :: packed
     real(dp) :: mv(3 * particle_block_size), vs(6 * particle_block_size), mg(3 * particle_block_size)
+    real(dp) :: fac(20 * particle_block_size)
+    logical :: into_records
 
     call p2g_factors(b%count, st%nd, st%nc, b%vol0, b%f, b%stress_global, b%mass, b%v, st%gravity, mv, vs, mg)
-    call scatter_p2g(b%count, st%nsup, st%nd, st%nc, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
-         b%dw1, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
+    into_records = .false.
+    if (present(packed)) into_records = packed
+    if (into_records) then
+       call scatter_p2g_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
+            b%mass, mv, vs, mg, fac, st%gpack)
+    else
+       call scatter_p2g(b%count, st%nsup, st%nd, st%nc, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+            b%w1, b%dw1, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
+    end if
   end subroutine p2g
 
   !> p2g's particle factors m v, V σ (V = V0 det F) and m g of a block.
@@ -498,6 +519,30 @@ contains
     call scatter_momentum(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, dv, &
          st%g%mom)
   end subroutine g2p
+
+  !> g2p's gather and particle update for 3D uGIMP on st%gpack's velocity records (v_new, v_old);
+  !> the remap is remap_packed's, after every block's update (musl_transfer).
+  subroutine g2p_packed(st, b, alpha)
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), intent(inout) :: b
+    real(dp), intent(in) :: alpha
+    real(dp) :: vpic(3 * particle_block_size), dv(3 * particle_block_size), wk
+
+    call gather_velocity_3d_packed_pic(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+         st%gpack, vpic, dv)
+    call g2p_update(b%count, st%nd, alpha, st%dt, st%gravity, b%mass, vpic, dv, b%v, b%x, wk)
+    st%w_external = st%w_external + wk
+  end subroutine g2p_packed
+
+  !> g2p's MUSL remap for 3D uGIMP into st%gpack's momentum records (the first 4 nn values).
+  subroutine remap_packed(st, b)
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), intent(in) :: b
+    real(dp) :: mv4(4 * particle_block_size)
+
+    call scatter_momentum_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%mass, &
+         b%v, mv4, st%gpack)
+  end subroutine remap_packed
 
   !> g2p's particle update: PIC/FLIP velocity, position, the gravity's work wk; dv returns the
   !> particles' momentum m v for the remap.

@@ -31,6 +31,7 @@ module mpm_transfer
   public :: scatter_particles, g2p_particles
   public :: scatter_particles_3d_packed, gather_velocity_3d_packed, gather_gradient_3d_packed
   public :: remap_particles_3d_packed, unpack_momentum, pack_velocities, unpack_grid_sums
+  public :: scatter_p2g_3d_packed, gather_velocity_3d_packed_pic, scatter_momentum_3d_packed
 
 contains
 
@@ -253,6 +254,128 @@ contains
        end do
     end do
   end subroutine scatter_particles_3d_packed
+
+  !> scatter_p2g for 3D uGIMP (node-major, SORT = 0) into packed records gs(8, nn) as
+  !> scatter_particles_3d_packed: the particle factors packed first into fac(4, 5, nb) (work), then
+  !> the sums of mpm_transfer_scatter_3d.inc, s outer and p inner, each lane in its order.
+  pure subroutine scatter_p2g_3d_packed(nb, nn, nx, nxy, corner, w1, dw1, mp, mv, vs, mg, fac, gs)
+    integer, parameter :: nsup = 3
+    integer, intent(in) :: nb, nn, nx, nxy
+    integer, intent(in) :: corner(nb)
+    real(dp), intent(in) :: w1(nb, nsup, 3), dw1(nb, nsup, 3), mp(nb), mv(nb, 3), vs(nb, 6), mg(nb, 3)
+    real(dp), intent(out) :: fac(4, 5, nb)
+    real(dp), intent(inout) :: gs(8, nn)
+    real(dp) :: wp, dx, dy, dz, t, u
+    integer :: a, b, c, off, p, i, k
+
+    do p = 1, nb
+       fac(1, 1, p) = mp(p)
+       do k = 1, 3
+          fac(k + 1, 1, p) = mv(p, k)
+          fac(k, 2, p) = mg(p, k)
+       end do
+       fac(4, 2, p) = 0
+       fac(:, 3, p) = [vs(p, 1), vs(p, 4), vs(p, 6), 0.0_dp]
+       fac(:, 4, p) = [vs(p, 4), vs(p, 2), vs(p, 5), 0.0_dp]
+       fac(:, 5, p) = [vs(p, 6), vs(p, 5), vs(p, 3), 0.0_dp]
+    end do
+    do c = 1, nsup
+       do b = 1, nsup
+          do a = 1, nsup
+             off = (a - 1) + nx * (b - 1) + nxy * (c - 1)
+             do p = 1, nb
+                i = corner(p) + off
+                wp = w1(p, a, 1) * w1(p, b, 2) * w1(p, c, 3)
+                dx = dw1(p, a, 1) * w1(p, b, 2) * w1(p, c, 3)
+                dy = w1(p, a, 1) * dw1(p, b, 2) * w1(p, c, 3)
+                dz = w1(p, a, 1) * w1(p, b, 2) * dw1(p, c, 3)
+                !GCC$ unroll 1
+                do k = 1, 4
+                   gs(k, i) = gs(k, i) + wp * fac(k, 1, p)
+                end do
+                !GCC$ unroll 1
+                do k = 1, 4
+                   t = fac(k, 3, p) * dx + fac(k, 4, p) * dy + fac(k, 5, p) * dz
+                   u = wp * fac(k, 2, p) - t
+                   gs(4 + k, i) = gs(4 + k, i) + u
+                end do
+             end do
+          end do
+       end do
+    end do
+  end subroutine scatter_p2g_3d_packed
+
+  !> gather_velocity for 3D uGIMP on packed records gv(8, nn) (v_new lanes 1:4, v_old 5:8):
+  !> vpic = Σ S v_new, dv = Σ S (v_new − v_old), the sums of mpm_transfer_gather_velocity.inc.
+  pure subroutine gather_velocity_3d_packed_pic(nb, nn, nx, nxy, corner, w1, gv, vpic, dv)
+    integer, parameter :: nsup = 3
+    integer, intent(in) :: nb, nn, nx, nxy
+    integer, intent(in) :: corner(nb)
+    real(dp), intent(in) :: w1(nb, nsup, 3), gv(8, nn)
+    real(dp), intent(out) :: vpic(nb, 3), dv(nb, 3)
+    real(dp) :: sv(4), sd(4), ws
+    integer :: a, b, c, p, i, k
+
+    do p = 1, nb
+       sv = 0
+       sd = 0
+       do c = 1, nsup
+          do b = 1, nsup
+             do a = 1, nsup
+                i = corner(p) + (a - 1) + nx * (b - 1) + nxy * (c - 1)
+                ws = w1(p, a, 1) * w1(p, b, 2)
+                ws = ws * w1(p, c, 3)
+                !GCC$ unroll 1
+                do k = 1, 4
+                   sv(k) = sv(k) + ws * gv(k, i)
+                   sd(k) = sd(k) + ws * (gv(k, i) - gv(4 + k, i))
+                end do
+             end do
+          end do
+       end do
+       do k = 1, 3
+          vpic(p, k) = sv(k)
+          dv(p, k) = sd(k)
+       end do
+    end do
+  end subroutine gather_velocity_3d_packed_pic
+
+  !> scatter_momentum for 3D uGIMP (node-major, SORT = 0) into packed records gm(4, nn): the
+  !> momentum m v packed into mv4(4, nb) (work), then the sums of
+  !> mpm_transfer_scatter_momentum.inc, s outer and p inner.
+  pure subroutine scatter_momentum_3d_packed(nb, nn, nx, nxy, corner, w1, mp, v, mv4, gm)
+    integer, parameter :: nsup = 3
+    integer, intent(in) :: nb, nn, nx, nxy
+    integer, intent(in) :: corner(nb)
+    real(dp), intent(in) :: w1(nb, nsup, 3), mp(nb), v(nb, 3)
+    real(dp), intent(out) :: mv4(4, nb)
+    real(dp), intent(inout) :: gm(4, nn)
+    real(dp) :: ws
+    integer :: a, b, c, off, p, i, k
+
+    do p = 1, nb
+       do k = 1, 3
+          mv4(k, p) = mp(p) * v(p, k)
+       end do
+       mv4(4, p) = 0
+    end do
+    do c = 1, nsup
+       do b = 1, nsup
+          do a = 1, nsup
+             off = (a - 1) + nx * (b - 1) + nxy * (c - 1)
+             do p = 1, nb
+                i = corner(p) + off
+                ws = w1(p, a, 1) * w1(p, b, 2)
+                ws = ws * w1(p, c, 3)
+                !GCC$ unroll 1
+                do k = 1, 4
+                   gm(k, i) = gm(k, i) + ws * mv4(k, p)
+                end do
+             end do
+          end do
+       end do
+    end do
+  end subroutine scatter_momentum_3d_packed
 
   !> The grid sums from the packed records: mass, mom, force of nodes 1..nn (every node written).
   pure subroutine unpack_grid_sums(nn, gs, gmass, gmom, gforce)
