@@ -17,7 +17,8 @@ module mpm_musl
   use mpm_shape, only: block_stencil
   use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles, &
        scatter_particles_3d_packed, gather_velocity_3d_packed, remap_particles_3d_packed, unpack_momentum, &
-       pack_velocities, unpack_grid_sums, scatter_p2g_3d_packed, gather_velocity_3d_packed_pic, &
+       pack_velocities, unpack_grid_sums, scatter_p2g_3d_packed, gather_velocity_3d_packed_pic, stencil_span, &
+       clear_records, &
        scatter_momentum_3d_packed
   use mpm_sort, only: sort_due, sort_blocks
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
@@ -97,7 +98,7 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(effects_t), intent(inout) :: fx
-    integer :: ib, k, s
+    integer :: ib, k, s, ilo, ihi
     real(dp) :: e_walls0, e_damping0
     logical :: packed, sorted
 
@@ -108,6 +109,8 @@ contains
     ! vectorised; the same sums in the same order
     packed = st%nd == 3 .and. st%nsup == 3
     sorted = m%mpm%steps(s)%sort > 0
+    ilo = 1
+    ihi = 0
     if (packed) then
        if (allocated(st%gpack)) then
           if (size(st%gpack, 2) /= st%g%nn) deallocate (st%gpack)
@@ -115,16 +118,23 @@ contains
        if (.not. allocated(st%gpack)) allocate (st%gpack(8, st%g%nn))
     end if
     call fx%start(fx_p2g)
-    if (packed) then
-       call grid_clear(8 * st%g%nn, st%gpack)
-    else
-       call grid_reset_sums(st%g)
-    end if
+    if (.not. packed) call grid_reset_sums(st%g)
     ! *MPM CONTROLS, SORT=n: particles in cell order, transfers particle by particle (mpm_sort)
     if (sort_due(m%mpm%steps(s)%sort, st%increment)) &
          call sort_blocks(st%blocks, st%nblocks, st%nd, st%g%lo, st%g%h, st%g%n)
+    if (packed) then
+       ! every block's stencils first: the span of nodes they touch, the only records cleared,
+       ! packed and unpacked in this increment (the nodes beyond get zero sums)
+       ilo = huge(ilo)
+       ihi = 0
+       do ib = 1, st%nblocks
+          call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
+          call stencil_span(st%blocks(ib)%count, st%g%n(1), st%g%n(1) * st%g%n(2), st%blocks(ib)%corner, ilo, ihi)
+       end do
+       call clear_records(st%g%nn, ilo, ihi, 8, st%gpack)
+    end if
     do ib = 1, st%nblocks
-       call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
+       if (.not. packed) call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
        if (packed .and. sorted) then
           associate (b => st%blocks(ib))
             call scatter_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
@@ -139,7 +149,7 @@ contains
           call p2g(st, st%blocks(ib), packed)
        end if
     end do
-    if (packed) call unpack_grid_sums(st%g%nn, st%gpack, st%g%mass, st%g%mom, st%g%force)
+    if (packed) call unpack_grid_sums(st%g%nn, ilo, ihi, st%gpack, st%g%mass, st%g%mom, st%g%force)
     call exchange_grid_sums(st, fx, fx_p2g, .true.)
     st%g%mass_own = st%g%mass
     st%wall_force = 0
@@ -197,7 +207,7 @@ contains
        ! every block's gather and particle update (v_new, v_old packed), then every block's remap
        ! into the records' first 4 nn values: each node's sum in the particle order of the
        ! block-by-block loop below
-       call pack_velocities(st%g%nn, 8, st%g%v_new, st%g%v_old, st%gpack)
+       call pack_velocities(st%g%nn, ilo, ihi, 8, st%g%v_new, st%g%v_old, st%gpack)
        do ib = 1, st%nblocks
           associate (b => st%blocks(ib))
             if (sorted) then
@@ -208,7 +218,7 @@ contains
             end if
           end associate
        end do
-       call grid_clear(4 * st%g%nn, st%gpack)
+       call clear_records(st%g%nn, ilo, ihi, 4, st%gpack)
        do ib = 1, st%nblocks
           associate (b => st%blocks(ib))
             if (sorted) then
@@ -219,7 +229,7 @@ contains
             end if
           end associate
        end do
-       call unpack_momentum(st%g%nn, st%gpack, st%g%mom)
+       call unpack_momentum(st%g%nn, ilo, ihi, st%gpack, st%g%mom)
     else
        call grid_clear(st%nd * st%g%nn, st%g%mom)
        do ib = 1, st%nblocks
@@ -265,7 +275,7 @@ contains
        call fx%stop(fx_walls)
     end if
     ! the remapped velocity for the stress update's gradient gather (mpm_stress_update)
-    if (packed) call pack_velocities(st%g%nn, 4, st%g%v_new, st%g%v_new, st%gpack)
+    if (packed) call pack_velocities(st%g%nn, ilo, ihi, 4, st%g%v_new, st%g%v_new, st%gpack)
   end subroutine musl_transfer
 
   !> The rigid surfaces at t_n+1: their reference nodes' velocity over the increment and

@@ -30,7 +30,7 @@ module mpm_transfer
   public :: scatter_p2g, gather_velocity, scatter_momentum, gather_gradient
   public :: scatter_particles, g2p_particles
   public :: scatter_particles_3d_packed, gather_velocity_3d_packed, gather_gradient_3d_packed
-  public :: remap_particles_3d_packed, unpack_momentum, pack_velocities, unpack_grid_sums
+  public :: remap_particles_3d_packed, unpack_momentum, pack_velocities, unpack_grid_sums, stencil_span, clear_records
   public :: scatter_p2g_3d_packed, gather_velocity_3d_packed_pic, scatter_momentum_3d_packed
 
 contains
@@ -377,33 +377,59 @@ contains
     end do
   end subroutine scatter_momentum_3d_packed
 
-  !> The grid sums from the packed records: mass, mom, force of nodes 1..nn (every node written).
-  pure subroutine unpack_grid_sums(nn, gs, gmass, gmom, gforce)
-    integer, intent(in) :: nn
+  !> Nodes ilo..ihi (1-based; empty when ilo > ihi) hold every stencil of the blocks whose
+  !> corners are corner(1:nb) (3D uGIMP): the span in memory order of the nodes the packed
+  !> kernels touch, widened by one block's corners (the caller starts from ilo = huge, ihi = 0).
+  pure subroutine stencil_span(nb, nx, nxy, corner, ilo, ihi)
+    integer, intent(in) :: nb, nx, nxy
+    integer, intent(in) :: corner(nb)
+    integer, intent(inout) :: ilo, ihi
+    integer :: p
+
+    do p = 1, nb
+       ilo = min(ilo, corner(p))
+       ihi = max(ihi, corner(p) + 2 + 2 * nx + 2 * nxy)
+    end do
+  end subroutine stencil_span
+
+  !> The grid sums from the packed records: mass, mom, force of nodes 1..nn, gs(:, ilo:ihi)
+  !> there, zero elsewhere (no particle's stencil reaches beyond: stencil_span).
+  pure subroutine unpack_grid_sums(nn, ilo, ihi, gs, gmass, gmom, gforce)
+    integer, intent(in) :: nn, ilo, ihi
     real(dp), intent(in) :: gs(8, nn)
     real(dp), intent(out) :: gmass(nn), gmom(3, nn), gforce(3, nn)
     integer :: i
 
     do i = 1, nn
-       gmass(i) = gs(1, i)
-       gmom(1, i) = gs(2, i)
-       gmom(2, i) = gs(3, i)
-       gmom(3, i) = gs(4, i)
-       gforce(1, i) = gs(5, i)
-       gforce(2, i) = gs(6, i)
-       gforce(3, i) = gs(7, i)
+       if (i < ilo .or. i > ihi) then
+          gmass(i) = 0
+          gmom(1, i) = 0
+          gmom(2, i) = 0
+          gmom(3, i) = 0
+          gforce(1, i) = 0
+          gforce(2, i) = 0
+          gforce(3, i) = 0
+       else
+          gmass(i) = gs(1, i)
+          gmom(1, i) = gs(2, i)
+          gmom(2, i) = gs(3, i)
+          gmom(3, i) = gs(4, i)
+          gforce(1, i) = gs(5, i)
+          gforce(2, i) = gs(6, i)
+          gforce(3, i) = gs(7, i)
+       end if
     end do
   end subroutine unpack_grid_sums
 
-  !> Velocities into packed records: gv(1:3, i) = a(:, i), gv(4, i) = 0 [, gv(5:7, i) = b(:, i),
-  !> gv(8, i) = 0 when the records have 8 lanes] for nodes 1..nn.
-  pure subroutine pack_velocities(nn, nlane, a, b, gv)
-    integer, intent(in) :: nn, nlane
+  !> Velocities into packed records of nodes ilo..ihi: gv(1:3, i) = a(:, i), gv(4, i) = 0
+  !> [, gv(5:7, i) = b(:, i), gv(8, i) = 0 when the records have 8 lanes].
+  pure subroutine pack_velocities(nn, ilo, ihi, nlane, a, b, gv)
+    integer, intent(in) :: nn, ilo, ihi, nlane
     real(dp), intent(in) :: a(3, nn), b(3, nn)
-    real(dp), intent(out) :: gv(nlane, nn)
+    real(dp), intent(inout) :: gv(nlane, nn)
     integer :: i
 
-    do i = 1, nn
+    do i = ilo, ihi
        gv(1, i) = a(1, i)
        gv(2, i) = a(2, i)
        gv(3, i) = a(3, i)
@@ -416,6 +442,14 @@ contains
        end if
     end do
   end subroutine pack_velocities
+
+  !> Zero the packed records of nodes ilo..ihi (nlane lanes each).
+  pure subroutine clear_records(nn, ilo, ihi, nlane, gv)
+    integer, intent(in) :: nn, ilo, ihi, nlane
+    real(dp), intent(inout) :: gv(nlane, nn)
+
+    if (ihi >= ilo) gv(:, ilo:ihi) = 0
+  end subroutine clear_records
 
   !> The gather pass of g2p_particles for 3D uGIMP on packed records gv(8, nn) (v_new in lanes
   !> 1:4, v_old in 5:8): vpic = Σ S v_new, then v, x and wk as mpm_transfer_g2p_particles.inc.
@@ -487,17 +521,24 @@ contains
     end do
   end subroutine remap_particles_3d_packed
 
-  !> The momentum from packed records: mom(:, i) = gm(1:3, i) for nodes 1..nn.
-  pure subroutine unpack_momentum(nn, gm, gmom)
-    integer, intent(in) :: nn
+  !> The momentum from packed records: mom(:, i) = gm(1:3, i) for nodes ilo..ihi, zero elsewhere
+  !> (as unpack_grid_sums).
+  pure subroutine unpack_momentum(nn, ilo, ihi, gm, gmom)
+    integer, intent(in) :: nn, ilo, ihi
     real(dp), intent(in) :: gm(4, nn)
     real(dp), intent(out) :: gmom(3, nn)
     integer :: i
 
     do i = 1, nn
-       gmom(1, i) = gm(1, i)
-       gmom(2, i) = gm(2, i)
-       gmom(3, i) = gm(3, i)
+       if (i < ilo .or. i > ihi) then
+          gmom(1, i) = 0
+          gmom(2, i) = 0
+          gmom(3, i) = 0
+       else
+          gmom(1, i) = gm(1, i)
+          gmom(2, i) = gm(2, i)
+          gmom(3, i) = gm(3, i)
+       end if
     end do
   end subroutine unpack_momentum
 
