@@ -109,47 +109,8 @@ contains
     ! vectorised; the same sums in the same order
     packed = st%nd == 3 .and. st%nsup == 3
     sorted = m%mpm%steps(s)%sort > 0
-    ilo = 1
-    ihi = 0
-    if (packed) then
-       if (allocated(st%gpack)) then
-          if (size(st%gpack, 2) /= st%g%nn) deallocate (st%gpack)
-       end if
-       if (.not. allocated(st%gpack)) allocate (st%gpack(8, st%g%nn))
-    end if
     call fx%start(fx_p2g)
-    if (.not. packed) call grid_reset_sums(st%g)
-    ! *MPM CONTROLS, SORT=n: particles in cell order, transfers particle by particle (mpm_sort)
-    if (sort_due(m%mpm%steps(s)%sort, st%increment)) &
-         call sort_blocks(st%blocks, st%nblocks, st%nd, st%g%lo, st%g%h, st%g%n)
-    if (packed) then
-       ! every block's stencils first: the span of nodes they touch, the only records cleared,
-       ! packed and unpacked in this increment (the nodes beyond get zero sums)
-       ilo = huge(ilo)
-       ihi = 0
-       do ib = 1, st%nblocks
-          call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
-          call stencil_span(st%blocks(ib)%count, st%g%n(1), st%g%n(1) * st%g%n(2), st%blocks(ib)%corner, ilo, ihi)
-       end do
-       call clear_records(st%g%nn, ilo, ihi, 8, st%gpack)
-    end if
-    do ib = 1, st%nblocks
-       if (.not. packed) call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
-       if (packed .and. sorted) then
-          associate (b => st%blocks(ib))
-            call scatter_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
-                 b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%gpack)
-          end associate
-       else if (m%mpm%steps(s)%sort > 0) then
-          associate (b => st%blocks(ib))
-            call scatter_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
-                 b%w1, b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%g%mass, st%g%mom, st%g%force)
-          end associate
-       else
-          call p2g(st, st%blocks(ib), packed)
-       end if
-    end do
-    if (packed) call unpack_grid_sums(st%g%nn, ilo, ihi, st%gpack, st%g%mass, st%g%mom, st%g%force)
+    call p2g_blocks(m, st, packed, sorted, ilo, ihi)
     call exchange_grid_sums(st, fx, fx_p2g, .true.)
     st%g%mass_own = st%g%mass
     st%wall_force = 0
@@ -203,47 +164,7 @@ contains
     call side_friction_work(m, st, fx)    ! its work on the velocity the walls left
 
     call fx%start(fx_g2p)
-    if (packed) then
-       ! every block's gather and particle update (v_new, v_old packed), then every block's remap
-       ! into the records' first 4 nn values: each node's sum in the particle order of the
-       ! block-by-block loop below
-       call pack_velocities(st%g%nn, ilo, ihi, 8, st%g%v_new, st%g%v_old, st%gpack)
-       do ib = 1, st%nblocks
-          associate (b => st%blocks(ib))
-            if (sorted) then
-               call gather_velocity_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
-                    b%w1, st%gpack, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%w_external)
-            else
-               call g2p_packed(st, b, m%mpm%steps(s)%flip)
-            end if
-          end associate
-       end do
-       call clear_records(st%g%nn, ilo, ihi, 4, st%gpack)
-       do ib = 1, st%nblocks
-          associate (b => st%blocks(ib))
-            if (sorted) then
-               call remap_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
-                    b%w1, b%mass, b%v, st%gpack)
-            else
-               call remap_packed(st, b)
-            end if
-          end associate
-       end do
-       call unpack_momentum(st%g%nn, ilo, ihi, st%gpack, st%g%mom)
-    else
-       call grid_clear(st%nd * st%g%nn, st%g%mom)
-       do ib = 1, st%nblocks
-          if (m%mpm%steps(s)%sort > 0) then
-             associate (b => st%blocks(ib))
-               call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
-                    b%w1, st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, &
-                    st%g%mom, st%w_external)
-             end associate
-          else
-             call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
-          end if
-       end do
-    end if
+    call g2p_blocks(m, st, packed, sorted, ilo, ihi)
     call exchange_grid_sums(st, fx, fx_g2p, .false.)
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
@@ -277,6 +198,112 @@ contains
     ! the remapped velocity for the stress update's gradient gather (mpm_stress_update)
     if (packed) call pack_velocities(st%g%nn, ilo, ihi, 4, st%g%v_new, st%g%v_new, st%gpack)
   end subroutine musl_transfer
+
+  !> musl_transfer's P2G over the blocks (stencils, sort, scatter) into st%g's sums. packed (3D
+  !> uGIMP): through st%gpack's records, over the span ilo..ihi of nodes the stencils touch
+  !> (returned for the G2P; 1, 0 otherwise).
+  subroutine p2g_blocks(m, st, packed, sorted, ilo, ihi)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    logical, intent(in) :: packed, sorted
+    integer, intent(out) :: ilo, ihi
+    integer :: ib, s
+
+    s = st%step
+    ilo = 1
+    ihi = 0
+    if (packed) then
+       if (allocated(st%gpack)) then
+          if (size(st%gpack, 2) /= st%g%nn) deallocate (st%gpack)
+       end if
+       if (.not. allocated(st%gpack)) allocate (st%gpack(8, st%g%nn))
+    else
+       call grid_reset_sums(st%g)
+    end if
+    ! *MPM CONTROLS, SORT=n: particles in cell order, transfers particle by particle (mpm_sort)
+    if (sort_due(m%mpm%steps(s)%sort, st%increment)) &
+         call sort_blocks(st%blocks, st%nblocks, st%nd, st%g%lo, st%g%h, st%g%n)
+    if (packed) then
+       ! every block's stencils first: the span of nodes they touch, the only records cleared,
+       ! packed and unpacked in this increment (the nodes beyond get zero sums)
+       ilo = huge(ilo)
+       ihi = 0
+       do ib = 1, st%nblocks
+          call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
+          call stencil_span(st%blocks(ib)%count, st%g%n(1), st%g%n(1) * st%g%n(2), st%blocks(ib)%corner, ilo, ihi)
+       end do
+       call clear_records(st%g%nn, ilo, ihi, 8, st%gpack)
+    end if
+    do ib = 1, st%nblocks
+       if (.not. packed) call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
+       if (packed .and. sorted) then
+          associate (b => st%blocks(ib))
+            call scatter_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+                 b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%gpack)
+          end associate
+       else if (sorted) then
+          associate (b => st%blocks(ib))
+            call scatter_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                 b%w1, b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%g%mass, st%g%mom, st%g%force)
+          end associate
+       else
+          call p2g(st, st%blocks(ib), packed)
+       end if
+    end do
+    if (packed) call unpack_grid_sums(st%g%nn, ilo, ihi, st%gpack, st%g%mass, st%g%mom, st%g%force)
+  end subroutine p2g_blocks
+
+  !> musl_transfer's G2P and MUSL remap over the blocks into st%g%mom (packed: as p2g_blocks).
+  subroutine g2p_blocks(m, st, packed, sorted, ilo, ihi)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    logical, intent(in) :: packed, sorted
+    integer, intent(in) :: ilo, ihi
+    integer :: ib, s
+
+    s = st%step
+    if (packed) then
+       ! every block's gather and particle update (v_new, v_old packed), then every block's remap
+       ! into the records' first 4 nn values: each node's sum in the particle order of the
+       ! block-by-block loop below
+       call pack_velocities(st%g%nn, ilo, ihi, 8, st%g%v_new, st%g%v_old, st%gpack)
+       do ib = 1, st%nblocks
+          associate (b => st%blocks(ib))
+            if (sorted) then
+               call gather_velocity_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, st%gpack, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%w_external)
+            else
+               call g2p_packed(st, b, m%mpm%steps(s)%flip)
+            end if
+          end associate
+       end do
+       call clear_records(st%g%nn, ilo, ihi, 4, st%gpack)
+       do ib = 1, st%nblocks
+          associate (b => st%blocks(ib))
+            if (sorted) then
+               call remap_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, b%mass, b%v, st%gpack)
+            else
+               call remap_packed(st, b)
+            end if
+          end associate
+       end do
+       call unpack_momentum(st%g%nn, ilo, ihi, st%gpack, st%g%mom)
+    else
+       call grid_clear(st%nd * st%g%nn, st%g%mom)
+       do ib = 1, st%nblocks
+          if (sorted) then
+             associate (b => st%blocks(ib))
+               call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, &
+                    st%g%mom, st%w_external)
+             end associate
+          else
+             call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
+          end if
+       end do
+    end if
+  end subroutine g2p_blocks
 
   !> The rigid surfaces at t_n+1: their reference nodes' velocity over the increment and
   !> displacement (rigid_surface_motion), then the nodes of the active rigid-surface walls and
