@@ -483,50 +483,48 @@ contains
     integer :: e
 
     if (ndim == 2) then
-       ! One loop on scalars (no block temporaries); the same sums in the same order as below.
+       ! One loop on scalars (no block temporaries): ΔR = R_new R_oldᵀ, 1 + tr ΔR of the 3-D embedding
+       ! (ΔR33 = 1) and ω3 = spin − 2 (ΔR21 − ΔR12) / (1 + tr ΔR), the sums of the 3D form below.
        do e = 1, nb
           rel_spin(e, 1) = plane_relative_spin(spin_inc(e, 1), r_new(e, 1, 1), r_new(e, 2, 1), r_new(e, 1, 2), &
                r_new(e, 2, 2), r_old(e, 1, 1), r_old(e, 2, 1), r_old(e, 1, 2), r_old(e, 2, 2))
        end do
     else
-       call relative_spin_nd(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
+       call relative_spin_3d(nb, spin_inc, r_old, r_new, r_mid, rel_spin)
     end if
   end subroutine relative_spin
 
-  !> relative_spin on block temporaries, any ndim (used for 3D).
-  pure subroutine relative_spin_nd(nb, ndim, spin_inc, r_old, r_new, r_mid, rel_spin)
-    integer, intent(in) :: nb, ndim
-    real(dp), intent(in) :: spin_inc(nb, 2 * ndim - 3)
-    real(dp), intent(in) :: r_old(nb, ndim, ndim), r_new(nb, ndim, ndim), r_mid(nb, ndim, ndim)
-    real(dp), intent(out) :: rel_spin(nb, 2 * ndim - 3)
-    real(dp) :: dr(nb, ndim, ndim), w(nb, 3), trace1(nb)
-    integer :: i, j, k
+  !> relative_spin for ndim = 3, one element loop on scalars. It replaces a form on block
+  !> temporaries with runtime ndim (gfortran put them on the heap, malloc/free per block; issue
+  !> 19) with the same sums in the same order, from 0 as there, so the result is the same to the bit.
+  pure subroutine relative_spin_3d(nb, spin_inc, r_old, r_new, r_mid, rel_spin)
+    integer, intent(in) :: nb
+    real(dp), intent(in) :: spin_inc(nb, 3)
+    real(dp), intent(in) :: r_old(nb, 3, 3), r_new(nb, 3, 3), r_mid(nb, 3, 3)
+    real(dp), intent(out) :: rel_spin(nb, 3)
+    real(dp) :: dr(3, 3), w(3), trace1
+    integer :: e, i, j, k
 
-    ! ΔR_ij = Σ_k Rnew_ik Rold_jk
-    dr = 0.0_dp
-    do j = 1, ndim
-       do k = 1, ndim
-          do i = 1, ndim
-             dr(:, i, j) = dr(:, i, j) + r_new(:, i, k) * r_old(:, j, k)
+    do e = 1, nb
+       ! ΔR_ij = Σ_k Rnew_ik Rold_jk
+       do j = 1, 3
+          do i = 1, 3
+             dr(i, j) = 0.0_dp
+             do k = 1, 3
+                dr(i, j) = dr(i, j) + r_new(e, i, k) * r_old(e, j, k)
+             end do
           end do
        end do
-    end do
-    if (ndim == 2) then
-       ! 1 + tr ΔR of the 3-D embedding (ΔR33 = 1)
-       trace1 = 2.0_dp + dr(:, 1, 1) + dr(:, 2, 2)
-       rel_spin(:, 1) = spin_inc(:, 1) - 2.0_dp * (dr(:, 2, 1) - dr(:, 1, 2)) / trace1
-    else
-       trace1 = 1.0_dp + dr(:, 1, 1) + dr(:, 2, 2) + dr(:, 3, 3)
-       w(:, 1) = spin_inc(:, 1) - 2.0_dp * (dr(:, 3, 2) - dr(:, 2, 3)) / trace1
-       w(:, 2) = spin_inc(:, 2) - 2.0_dp * (dr(:, 1, 3) - dr(:, 3, 1)) / trace1
-       w(:, 3) = spin_inc(:, 3) - 2.0_dp * (dr(:, 2, 1) - dr(:, 1, 2)) / trace1
-       ! axial vectors transform as vectors under proper rotations: ω_c = Rᵀ ω
+       trace1 = 1.0_dp + dr(1, 1) + dr(2, 2) + dr(3, 3)
+       w(1) = spin_inc(e, 1) - 2.0_dp * (dr(3, 2) - dr(2, 3)) / trace1
+       w(2) = spin_inc(e, 2) - 2.0_dp * (dr(1, 3) - dr(3, 1)) / trace1
+       w(3) = spin_inc(e, 3) - 2.0_dp * (dr(2, 1) - dr(1, 2)) / trace1
        do i = 1, 3
-          rel_spin(:, i) = r_mid(:, 1, i) * w(:, 1) + r_mid(:, 2, i) * w(:, 2) &
-                           + r_mid(:, 3, i) * w(:, 3)
+          rel_spin(e, i) = r_mid(e, 1, i) * w(1) + r_mid(e, 2, i) * w(2) + r_mid(e, 3, i) * w(3)
        end do
-    end if
-  end subroutine relative_spin_nd
+    end do
+  end subroutine relative_spin_3d
+
 
   !> F in the VUMAT layout (nb, ndir + 2 nshr): 2D F11, F22, F33 (= 1), F12, F21;
   !> 3D F11, F22, F33, F12, F23, F31, F21, F32, F13.

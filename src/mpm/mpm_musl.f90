@@ -15,7 +15,11 @@ module mpm_musl
   use mpm_grid, only: grid_sum_length, grid_reset_sums, grid_clear
   use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_shape, only: block_stencil
-  use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles
+  use mpm_transfer, only: scatter_p2g, gather_velocity, scatter_momentum, scatter_particles, g2p_particles, &
+       scatter_particles_3d_packed, gather_velocity_3d_packed, remap_particles_3d_packed, unpack_momentum, &
+       pack_velocities, unpack_grid_sums, scatter_p2g_3d_packed, gather_velocity_3d_packed_pic, stencil_span, &
+       clear_records, &
+       scatter_momentum_3d_packed
   use mpm_sort, only: sort_due, sort_blocks
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
   use mpm_setup, only: mark_wall_nodes
@@ -94,28 +98,19 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(effects_t), intent(inout) :: fx
-    integer :: ib, k, s
+    integer :: ib, k, s, ilo, ihi
     real(dp) :: e_walls0, e_damping0
+    logical :: packed, sorted
 
     s = st%step
     e_walls0 = st%e_walls
     e_damping0 = st%e_damping
+    ! 3D uGIMP: the P2G, G2P + remap and gradient gather on packed node records (mpm_transfer),
+    ! vectorised; the same sums in the same order
+    packed = st%nd == 3 .and. st%nsup == 3
+    sorted = m%mpm%steps(s)%sort > 0
     call fx%start(fx_p2g)
-    call grid_reset_sums(st%g)
-    ! *MPM CONTROLS, SORT=n: particles in cell order, transfers particle by particle (mpm_sort)
-    if (sort_due(m%mpm%steps(s)%sort, st%increment)) &
-         call sort_blocks(st%blocks, st%nblocks, st%nd, st%g%lo, st%g%h, st%g%n)
-    do ib = 1, st%nblocks
-       call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
-       if (m%mpm%steps(s)%sort > 0) then
-          associate (b => st%blocks(ib))
-            call scatter_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
-                 b%w1, b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%g%mass, st%g%mom, st%g%force)
-          end associate
-       else
-          call p2g(st, st%blocks(ib))
-       end if
-    end do
+    call p2g_blocks(m, st, packed, sorted, ilo, ihi)
     call exchange_grid_sums(st, fx, fx_p2g, .true.)
     st%g%mass_own = st%g%mass
     st%wall_force = 0
@@ -169,18 +164,7 @@ contains
     call side_friction_work(m, st, fx)    ! its work on the velocity the walls left
 
     call fx%start(fx_g2p)
-    call grid_clear(st%nd * st%g%nn, st%g%mom)
-    do ib = 1, st%nblocks
-       if (m%mpm%steps(s)%sort > 0) then
-          associate (b => st%blocks(ib))
-            call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
-                 st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%g%mom, &
-                 st%w_external)
-          end associate
-       else
-          call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
-       end if
-    end do
+    call g2p_blocks(m, st, packed, sorted, ilo, ihi)
     call exchange_grid_sums(st, fx, fx_g2p, .false.)
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)
@@ -211,7 +195,115 @@ contains
        end do
        call fx%stop(fx_walls)
     end if
+    ! the remapped velocity for the stress update's gradient gather (mpm_stress_update)
+    if (packed) call pack_velocities(st%g%nn, ilo, ihi, 4, st%g%v_new, st%g%v_new, st%gpack)
   end subroutine musl_transfer
+
+  !> musl_transfer's P2G over the blocks (stencils, sort, scatter) into st%g's sums. packed (3D
+  !> uGIMP): through st%gpack's records, over the span ilo..ihi of nodes the stencils touch
+  !> (returned for the G2P; 1, 0 otherwise).
+  subroutine p2g_blocks(m, st, packed, sorted, ilo, ihi)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    logical, intent(in) :: packed, sorted
+    integer, intent(out) :: ilo, ihi
+    integer :: ib, s
+
+    s = st%step
+    ilo = 1
+    ihi = 0
+    if (packed) then
+       if (allocated(st%gpack)) then
+          if (size(st%gpack, 2) /= st%g%nn) deallocate (st%gpack)
+       end if
+       if (.not. allocated(st%gpack)) allocate (st%gpack(8, st%g%nn))
+    else
+       call grid_reset_sums(st%g)
+    end if
+    ! *MPM CONTROLS, SORT=n: particles in cell order, transfers particle by particle (mpm_sort)
+    if (sort_due(m%mpm%steps(s)%sort, st%increment)) &
+         call sort_blocks(st%blocks, st%nblocks, st%nd, st%g%lo, st%g%h, st%g%n)
+    if (packed) then
+       ! every block's stencils first: the span of nodes they touch, the only records cleared,
+       ! packed and unpacked in this increment (the nodes beyond get zero sums)
+       ilo = huge(ilo)
+       ihi = 0
+       do ib = 1, st%nblocks
+          call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
+          call stencil_span(st%blocks(ib)%count, st%g%n(1), st%g%n(1) * st%g%n(2), st%blocks(ib)%corner, ilo, ihi)
+       end do
+       call clear_records(st%g%nn, ilo, ihi, 8, st%gpack)
+    end if
+    do ib = 1, st%nblocks
+       if (.not. packed) call stencil(st, st%blocks(ib), m%mpm%shape, m%input_file)
+       if (packed .and. sorted) then
+          associate (b => st%blocks(ib))
+            call scatter_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+                 b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%gpack)
+          end associate
+       else if (sorted) then
+          associate (b => st%blocks(ib))
+            call scatter_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                 b%w1, b%dw1, b%mass, b%vol0, b%f, b%v, b%stress_global, st%gravity, st%g%mass, st%g%mom, st%g%force)
+          end associate
+       else
+          call p2g(st, st%blocks(ib), packed)
+       end if
+    end do
+    if (packed) call unpack_grid_sums(st%g%nn, ilo, ihi, st%gpack, st%g%mass, st%g%mom, st%g%force)
+  end subroutine p2g_blocks
+
+  !> musl_transfer's G2P and MUSL remap over the blocks into st%g%mom (packed: as p2g_blocks).
+  subroutine g2p_blocks(m, st, packed, sorted, ilo, ihi)
+    type(model_t), intent(in) :: m
+    type(mpm_state_t), intent(inout) :: st
+    logical, intent(in) :: packed, sorted
+    integer, intent(in) :: ilo, ihi
+    integer :: ib, s
+
+    s = st%step
+    if (packed) then
+       ! every block's gather and particle update (v_new, v_old packed), then every block's remap
+       ! into the records' first 4 nn values: each node's sum in the particle order of the
+       ! block-by-block loop below
+       call pack_velocities(st%g%nn, ilo, ihi, 8, st%g%v_new, st%g%v_old, st%gpack)
+       do ib = 1, st%nblocks
+          associate (b => st%blocks(ib))
+            if (sorted) then
+               call gather_velocity_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, st%gpack, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%w_external)
+            else
+               call g2p_packed(st, b, m%mpm%steps(s)%flip)
+            end if
+          end associate
+       end do
+       call clear_records(st%g%nn, ilo, ihi, 4, st%gpack)
+       do ib = 1, st%nblocks
+          associate (b => st%blocks(ib))
+            if (sorted) then
+               call remap_particles_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, b%mass, b%v, st%gpack)
+            else
+               call remap_packed(st, b)
+            end if
+          end associate
+       end do
+       call unpack_momentum(st%g%nn, ilo, ihi, st%gpack, st%g%mom)
+    else
+       call grid_clear(st%nd * st%g%nn, st%g%mom)
+       do ib = 1, st%nblocks
+          if (sorted) then
+             associate (b => st%blocks(ib))
+               call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+                    b%w1, st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, &
+                    st%g%mom, st%w_external)
+             end associate
+          else
+             call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
+          end if
+       end do
+    end if
+  end subroutine g2p_blocks
 
   !> The rigid surfaces at t_n+1: their reference nodes' velocity over the increment and
   !> displacement (rigid_surface_motion), then the nodes of the active rigid-surface walls and
@@ -350,14 +442,26 @@ contains
   !> The factors' work arrays are fixed-size locals of particle_block_size rows' room, seen by
   !> p2g_factors and the scatter as (count, ·) arrays (sequence association): as automatic arrays
   !> of b%count rows gfortran allocated them on the heap per block and increment (issue 19).
-  subroutine p2g(st, b)
+  !> packed present and true (3D uGIMP): the sums go to st%gpack's records
+  !> (scatter_p2g_3d_packed), the caller unpacks them.
+  subroutine p2g(st, b, packed)
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(in) :: b
+    logical, intent(in), optional :: packed
     real(dp) :: mv(3 * particle_block_size), vs(6 * particle_block_size), mg(3 * particle_block_size)
+    real(dp) :: fac(20 * particle_block_size)
+    logical :: into_records
 
     call p2g_factors(b%count, st%nd, st%nc, b%vol0, b%f, b%stress_global, b%mass, b%v, st%gravity, mv, vs, mg)
-    call scatter_p2g(b%count, st%nsup, st%nd, st%nc, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
-         b%dw1, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
+    into_records = .false.
+    if (present(packed)) into_records = packed
+    if (into_records) then
+       call scatter_p2g_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
+            b%mass, mv, vs, mg, fac, st%gpack)
+    else
+       call scatter_p2g(b%count, st%nsup, st%nd, st%nc, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
+            b%w1, b%dw1, b%mass, mv, vs, mg, st%g%mass, st%g%mom, st%g%force)
+    end if
   end subroutine p2g
 
   !> p2g's particle factors m v, V σ (V = V0 det F) and m g of a block.
@@ -408,10 +512,16 @@ contains
     do i = 1, nn
        active(i) = mass(i) > cutoff
        if (.not. active(i)) then
-          do k = 1, nd
-             v_old(k, i) = 0
-             v_new(k, i) = 0
-          end do
+          ! component by component, not a loop to nd: gcc made that loop two memset calls per
+          ! inactive node (issue 19)
+          v_old(1, i) = 0
+          v_old(2, i) = 0
+          v_new(1, i) = 0
+          v_new(2, i) = 0
+          if (nd == 3) then
+             v_old(nd, i) = 0
+             v_new(nd, i) = 0
+          end if
           cycle
        end if
        do k = 1, nd
@@ -446,6 +556,30 @@ contains
     call scatter_momentum(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, dv, &
          st%g%mom)
   end subroutine g2p
+
+  !> g2p's gather and particle update for 3D uGIMP on st%gpack's velocity records (v_new, v_old);
+  !> the remap is remap_packed's, after every block's update (musl_transfer).
+  subroutine g2p_packed(st, b, alpha)
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), intent(inout) :: b
+    real(dp), intent(in) :: alpha
+    real(dp) :: vpic(3 * particle_block_size), dv(3 * particle_block_size), wk
+
+    call gather_velocity_3d_packed_pic(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, &
+         st%gpack, vpic, dv)
+    call g2p_update(b%count, st%nd, alpha, st%dt, st%gravity, b%mass, vpic, dv, b%v, b%x, wk)
+    st%w_external = st%w_external + wk
+  end subroutine g2p_packed
+
+  !> g2p's MUSL remap for 3D uGIMP into st%gpack's momentum records (the first 4 nn values).
+  subroutine remap_packed(st, b)
+    type(mpm_state_t), intent(inout) :: st
+    type(particle_block_t), intent(in) :: b
+    real(dp) :: mv4(4 * particle_block_size)
+
+    call scatter_momentum_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%mass, &
+         b%v, mv4, st%gpack)
+  end subroutine remap_packed
 
   !> g2p's particle update: PIC/FLIP velocity, position, the gravity's work wk; dv returns the
   !> particles' momentum m v for the remap.

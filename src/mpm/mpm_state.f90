@@ -43,6 +43,12 @@ module mpm_state
      logical, allocatable :: mirrored(:)
      !> the spatial decomposition of the grid (mpm_domain; %on false: the replicated grid)
      type(domain_t) :: dom
+     !> 3D uGIMP: (8, nn) the grid's node values as packed 4-lane records for the vectorised
+     !> transfer kernels (mpm_transfer, "packed node records"): in turn the P2G sums, v_new and
+     !> v_old for the G2P, the remapped momentum, and (first 4 nn values) the remapped velocity
+     !> for the stress update's gradient gather. Scratch of the increment (musl_transfer fills
+     !> it), not state: not checkpointed.
+     real(dp), allocatable :: gpack(:, :)
      real(dp), allocatable :: modulus(:)             !< per material: λ + 2G (packaging call)
      logical, allocatable :: needs_kinematics(:)     !< per material: user VUMAT reads F, U
      !> VUMAT work sets: work(1) has particle_block_size rows (full blocks), work(2) the rows of

@@ -13,7 +13,7 @@ module mpm_stress_update
   use model, only: model_t
   use mpm_state, only: mpm_state_t, fx_kinematics, fx_material
   use mpm_particles, only: particle_block_t, particle_block_size
-  use mpm_transfer, only: gather_gradient
+  use mpm_transfer, only: gather_gradient, gather_gradient_3d_packed
   use model_particle_fields, only: particle_temperature
   use material_door, only: vumat_work_t, vumat_work_init, call_material, call_field
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
@@ -47,8 +47,14 @@ contains
     nb = b%count
     nd = st%nd
     dt = st%dt
-    call gather_gradient(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
-         st%g%v_new, l)
+    if (nd == 3 .and. st%nsup == 3) then
+       ! 3D uGIMP: v_new as packed records (musl_transfer packed it), the same sums vectorised
+       call gather_gradient_3d_packed(nb, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
+            st%gpack, l)
+    else
+       call gather_gradient(nb, st%nsup, nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%dw1, &
+            st%g%v_new, l)
+    end if
     call block_kinematics(nb, nd, st%nc, dt, l, b%f, f_mid, f_new, strain, spin)
     call polar_rotation(nb, nd, f_mid, r_mid)
     call polar_rotation(nb, nd, f_new, r_new)
