@@ -12,11 +12,14 @@ that has it: the new history may end with one row more and the new .h5 may hold 
 (the stop's), everything the old wrote must be the same bytes.
 
 OLD_BIN is typically main's build (build it from a clean checkout of main), NEW_BIN the branch's.
-Prints one line per deck and exits 1 if any deck differs.
+Prints one line per deck and exits 1 if any deck differs. A deck that neither binary ran (both exit
+non-zero without writing a history, e.g. mpirun refusing to start) is "NOT COMPARED" and counts as
+a difference: two failures prove nothing. Open MPI's run-as-root variables are set for --ranks > 1.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import subprocess
 import sys
 import tempfile
@@ -86,6 +89,9 @@ def main(argv=None) -> int:
         work = a.workdir or Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         differ = 0
+        env = dict(os.environ)
+        if a.ranks > 1:
+            env.update(OMPI_ALLOW_RUN_AS_ROOT='1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM='1')
         for deck in a.decks:
             runs = []
             for tag, exe in (('old', a.old), ('new', a.new)):
@@ -93,10 +99,15 @@ def main(argv=None) -> int:
                 launch = [a.mpiexec, '-np', str(a.ranks), '--oversubscribe'] if a.ranks > 1 else []
                 stop = ['--stop-after', str(a.stop_after)] if a.stop_after > 0 else []
                 p = subprocess.run(launch + [exe, str(deck.resolve()), '--output', str(base), *stop, '--quiet'],
-                                   capture_output=True, text=True, timeout=a.timeout)
-                runs.append((base, p.returncode))
-            (b0, r0), (b1, r1) = runs
+                                   capture_output=True, text=True, timeout=a.timeout, env=env)
+                runs.append((base, p.returncode, (p.stderr.strip() or p.stdout.strip()).splitlines()[-1:]))
+            (b0, r0, e0), (b1, r1, e1) = runs
             h0, h1 = Path(f'{b0}_history.csv'), Path(f'{b1}_history.csv')
+            if r0 != 0 and r1 != 0 and not h0.exists() and not h1.exists():
+                differ += 1
+                print(f'NOT COMPARED  {deck}: exit {r0}/{r1}, neither run wrote a history '
+                      f'(old: {" ".join(e0) or "no output"}; new: {" ".join(e1) or "no output"})')
+                continue
             same_history = h0.exists() == h1.exists() and (not h0.exists() or h0.read_bytes() == h1.read_bytes())
             extra = ''
             if a.stop_outputs and not same_history and h0.exists() and h1.exists():
@@ -116,7 +127,7 @@ def main(argv=None) -> int:
             print(f'{"same" if ok else "DIFFERS"}  {deck}: exit {r0}/{r1}, history '
                   f'{"identical" if same_history else "differs"}, .h5 '
                   f'{"identical" if not diffs else ", ".join(diffs[:4])}{extra}')
-    print('all identical' if not differ else f'{differ} of {len(a.decks)} decks differ')
+    print('all identical' if not differ else f'{differ} of {len(a.decks)} decks differ or were not compared')
     return 1 if differ else 0
 
 
