@@ -447,12 +447,17 @@ def study_convergence(a) -> Study:
     return st
 
 
-def _save_convergence(out: Path, rows: list[dict]) -> None:
-    with open(out / "convergence.csv", "w", newline="") as f:
+def _save_rows(out: Path, name: str, rows: list[dict], table) -> None:
+    """OUT/NAME.csv (one row per dict) and OUT/NAME_table.txt (table(rows), markdown)."""
+    with open(out / f"{name}.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    (out / "convergence_table.txt").write_text(convergence_table(rows) + "\n")
+    (out / f"{name}_table.txt").write_text(table(rows) + "\n")
+
+
+def _save_convergence(out: Path, rows: list[dict]) -> None:
+    _save_rows(out, "convergence", rows, convergence_table)
 
 
 def convergence_table(rows: list[dict]) -> str:
@@ -537,11 +542,7 @@ def study_meshdiag(a) -> Study:
 
 
 def _save_meshdiag(out: Path, rows: list[dict]) -> None:
-    with open(out / "meshdiag.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    (out / "meshdiag_table.txt").write_text(meshdiag_table(rows) + "\n")
+    _save_rows(out, "meshdiag", rows, meshdiag_table)
 
 
 def meshdiag_table(rows: list[dict]) -> str:
