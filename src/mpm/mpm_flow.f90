@@ -10,7 +10,7 @@ module mpm_flow
   use mpm_particles, only: particle_block_size, block_keep, drop_empty_blocks
   use mpm_walls, only: wall_contains, wall_distance, wall_rows_behind, wall_slide_velocity
   use mpm_lattice, only: add_particles
-  use parallel_comm, only: comm_max_owner, comm_any, comm_sum
+  use parallel_comm, only: comm_allgather
   implicit none
   private
 
@@ -155,22 +155,32 @@ contains
   end subroutine inflow
 
   !> The highest particle of every inflow column over all ranks and its velocity (the lowest
-  !> rank wins a tie, so exactly one rank supplies it).
+  !> rank wins a tie, so exactly one rank supplies it). One all-gather of every rank's
+  !> (top, velocity) per column: the increment's other collectives already make the ranks wait
+  !> for each other, so each one less is a synchronisation less.
   subroutine global_tops(st, ncol, seen, top, vtop)
     type(mpm_state_t), intent(in) :: st
     integer, intent(in) :: ncol
     logical, intent(inout) :: seen(ncol)
     real(dp), intent(inout) :: top(ncol), vtop(3, ncol)
-    integer :: owner(ncol), c
+    real(dp) :: mine(4 * ncol), all(4 * ncol, 0:st%nranks - 1)
+    integer :: c, r, owner
 
     do c = 1, ncol
-       if (.not. seen(c)) top(c) = -huge(1.0_dp)
+       mine(4 * c - 3) = -huge(1.0_dp)
+       if (seen(c)) mine(4 * c - 3) = top(c)
+       mine(4 * c - 2:4 * c) = vtop(:, c)
     end do
-    call comm_max_owner(st%comm, top, owner)
-    call comm_any(st%comm, seen)
+    call comm_allgather(st%comm, mine, all)
     do c = 1, ncol
-       if (owner(c) /= st%rank) vtop(:, c) = 0
+       owner = 0
+       do r = 1, st%nranks - 1
+          if (all(4 * c - 3, r) > all(4 * c - 3, owner)) owner = r
+       end do
+       seen(c) = all(4 * c - 3, owner) > -huge(1.0_dp)
+       top(c) = all(4 * c - 3, owner)
+       vtop(:, c) = 0
+       if (seen(c)) vtop(:, c) = all(4 * c - 2:4 * c, owner)
     end do
-    call comm_sum(st%comm, vtop)
   end subroutine global_tops
 end module mpm_flow

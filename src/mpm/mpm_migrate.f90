@@ -160,22 +160,40 @@ contains
     st%nblocks = st%nblocks + 1
   end subroutine append_block
 
-  !> The destination rank of every particle of the rank (dest(p, ib)), from its cell.
-  subroutine destinations(st, dest)
+  !> The destination rank of every particle of the rank (dest(p, ib)), from its cell (cell_of's
+  !> formula, written out so the loop over a block vectorises), and per block how many go to
+  !> another rank (most increments: none, and the caller skips those blocks).
+  subroutine destinations(st, dest, leaving)
     type(mpm_state_t), intent(in) :: st
     integer, intent(out) :: dest(:, :)          !< (particle_block_size, nblocks)
-    integer :: ib, p, c(3), r
+    integer, intent(out) :: leaving(:)          !< (nblocks)
+    integer :: ib, p, c(3), r, k, nd, ck, last(3), blo(3), bhi(3)
+    logical :: inside(particle_block_size)
+    real(dp) :: lo(3), h
 
     r = st%dom%rank
+    nd = st%nd
+    lo = st%g%lo
+    h = st%g%h
+    last = st%dom%ncell - 1
+    blo = st%dom%box(1, :, r)
+    bhi = st%dom%box(2, :, r)
     do ib = 1, st%nblocks
        associate (b => st%blocks(ib))
+         inside(1:b%count) = .true.
+         do k = 1, nd
+            do p = 1, b%count
+               ck = min(max(floor((b%x(p, k) - lo(k)) / h), 0), last(k))
+               inside(p) = inside(p) .and. ck >= blo(k) .and. ck <= bhi(k)
+            end do
+         end do
+         dest(1:b%count, ib) = r
+         leaving(ib) = b%count - count(inside(1:b%count))
+         if (leaving(ib) == 0) cycle
          do p = 1, b%count
-            c = cell_of(st%dom, st%g%lo, st%g%h, b%x(p, :))
-            if (all(c(1:st%nd) >= st%dom%box(1, 1:st%nd, r)) .and. all(c(1:st%nd) <= st%dom%box(2, 1:st%nd, r))) then
-               dest(p, ib) = r
-            else
-               dest(p, ib) = rank_of_cell(st%dom, c)
-            end if
+            if (inside(p)) cycle
+            c = cell_of(st%dom, lo, h, b%x(p, :))
+            dest(p, ib) = rank_of_cell(st%dom, c)
          end do
        end associate
     end do
@@ -188,19 +206,21 @@ contains
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     logical, intent(in) :: compact
-    integer, allocatable :: dest(:, :), keep(:), first(:), rfirst(:), slen(:)
+    integer, allocatable :: dest(:, :), leaving(:), keep(:), first(:), rfirst(:), slen(:)
     real(dp), allocatable :: sbuf(:), rbuf(:), kept(:)
     integer :: ib, p, r, nr, nk, pos, len, me, nown, own_pos
 
     nr = st%nranks
     me = st%rank
-    allocate (dest(particle_block_size, max(1, st%nblocks)), first(0:nr), rfirst(0:nr), slen(0:nr - 1))
-    call destinations(st, dest)
+    allocate (dest(particle_block_size, max(1, st%nblocks)), leaving(max(1, st%nblocks)), first(0:nr), &
+         rfirst(0:nr), slen(0:nr - 1))
+    call destinations(st, dest, leaving)
     ! sizes per destination rank (this rank's own rows apart: kept, or re-packed with compact)
     slen = 0
     nown = 0
     own_pos = 1
     do ib = 1, st%nblocks
+       if (leaving(ib) == 0 .and. .not. compact) cycle
        len = record_length(st%nd, st%nc, size(st%blocks(ib)%state, 2), size(st%blocks(ib)%field, 2))
        do p = 1, st%blocks(ib)%count
           r = dest(p, ib)
@@ -220,8 +240,10 @@ contains
     ! rows in rank order, block order within a rank
     do r = 0, nr - 1
        if (r == me .and. .not. compact) cycle
+       if (slen(r) == 0 .and. r /= me) cycle
        pos = first(r)
        do ib = 1, st%nblocks
+          if (leaving(ib) == 0 .and. r /= me) cycle
           do p = 1, st%blocks(ib)%count
              if (dest(p, ib) /= r) cycle
              if (r == me) then
@@ -239,13 +261,14 @@ contains
     else
        allocate (keep(particle_block_size))
        do ib = 1, st%nblocks
+          if (leaving(ib) == 0) cycle
           nk = 0
           do p = 1, st%blocks(ib)%count
              if (dest(p, ib) /= me) cycle
              nk = nk + 1
              keep(nk) = p
           end do
-          if (nk < st%blocks(ib)%count) call block_keep(st%blocks(ib), keep(1:nk))
+          call block_keep(st%blocks(ib), keep(1:nk))
        end do
        call drop_empty_blocks(st%blocks, st%nblocks)
     end if

@@ -7,6 +7,7 @@
 !>   scalars and arrays (every rank ends with the result)
 !> * `comm_bcast`: integers, reals, logicals, strings from a root rank
 !> * `comm_max_owner`: element-wise maximum over the ranks and the lowest rank that holds it
+!> * `comm_allgather`: every rank's array of one length, side by side in rank order, on every rank
 !> * `comm_send`, `comm_recv`: blocking point-to-point transfer of integer and real(dp) arrays
 !> * `comm_sum_exact`: an all-reduced sum of real(dp) values that is EXACT before one final
 !>   rounding, hence identical whatever the number of ranks and however the values are spread
@@ -19,7 +20,7 @@ module parallel_comm
   use mpi_f08, only: MPI_Comm, MPI_Datatype, MPI_Op, MPI_Comm_rank, MPI_Comm_size, MPI_Barrier, &
        MPI_Allreduce, MPI_Bcast, MPI_IN_PLACE, MPI_MIN, MPI_MAX, MPI_SUM, MPI_LOR, MPI_MAXLOC, &
        MPI_INTEGER, MPI_INTEGER8, MPI_DOUBLE_PRECISION, MPI_2DOUBLE_PRECISION, MPI_LOGICAL, MPI_CHARACTER, &
-       MPI_Send, MPI_Recv, MPI_STATUS_IGNORE
+       MPI_Send, MPI_Recv, MPI_STATUS_IGNORE, MPI_Allgather
   use base_kinds, only: dp
   implicit none
   private
@@ -29,6 +30,7 @@ module parallel_comm
   public :: comm_bcast
   public :: comm_sum_exact
   public :: comm_max_owner, comm_send, comm_recv
+  public :: comm_allgather
   public :: comm_sum_pieces
 
   !> True on every rank where the flag is true on at least one rank (arrays: element by element).
@@ -67,6 +69,11 @@ module parallel_comm
      module procedure bcast_int, bcast_int_array, bcast_real, bcast_real_array, bcast_logical, &
           bcast_string
   end interface comm_bcast
+
+  !> all(:, r) ← rank r's `mine` (every rank passes the same length). Collective.
+  interface comm_allgather
+     module procedure allgather_int, allgather_real
+  end interface comm_allgather
 
   !> Exact all-reduced sum: of a rank-1 array into a scalar, or of each column of a rank-2
   !> array into a rank-1 result (one reduction for several sums).
@@ -139,6 +146,20 @@ contains
        owner(i) = nint(pair(2, i))
     end do
   end subroutine comm_max_owner
+
+  subroutine allgather_int(comm, mine, all)
+    type(MPI_Comm), intent(in) :: comm
+    integer, contiguous, intent(in) :: mine(:)
+    integer, contiguous, intent(out) :: all(:, 0:)     !< (size(mine), 0:nranks − 1)
+    call MPI_Allgather(mine, size(mine), MPI_INTEGER, all, size(mine), MPI_INTEGER, comm)
+  end subroutine allgather_int
+
+  subroutine allgather_real(comm, mine, all)
+    type(MPI_Comm), intent(in) :: comm
+    real(dp), contiguous, intent(in) :: mine(:)
+    real(dp), contiguous, intent(out) :: all(:, 0:)    !< (size(mine), 0:nranks − 1)
+    call MPI_Allgather(mine, size(mine), MPI_DOUBLE_PRECISION, all, size(mine), MPI_DOUBLE_PRECISION, comm)
+  end subroutine allgather_real
 
   ! --- point to point -------------------------------------------------------------------------
 
