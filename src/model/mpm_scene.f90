@@ -99,7 +99,7 @@ module mpm_scene
      type(mpm_step_t), allocatable :: steps(:)
      !> grid over MPI ranks: replicated (every rank the whole grid) or spatial (mpm_domain)
      integer :: decomposition = decomposition_replicated
-     real(dp) :: rebalance = 0.25_dp         !< spatial: re-partition when max/mean − 1 of counts exceeds it
+     real(dp) :: rebalance = 0.02_dp         !< spatial: re-partition when max/mean − 1 of counts exceeds it
      type(mpm_nonlocal_t) :: nonlocal
   end type mpm_scene_t
 end module mpm_scene

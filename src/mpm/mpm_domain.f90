@@ -35,7 +35,7 @@ module mpm_domain
      integer, allocatable :: recv_first(:), recv_nodes(:)   !< per neighbour: owned nodes it holds
      integer, allocatable :: shared(:)   !< owned nodes some neighbour holds (ascending)
      integer, allocatable :: mirror_axis(:), mirror_layer(:)   !< mirrored planes (node layer)
-     real(dp) :: rebalance = 0.25_dp     !< re-partition when max/mean − 1 of the counts exceeds it
+     real(dp) :: rebalance = 0.02_dp     !< re-partition when max/mean − 1 of the counts exceeds it (and new boxes gain)
      integer :: rebalance_every = 20     !< increments between the imbalance checks
      integer :: rebalances = 0           !< re-partitions done in this run
      integer, allocatable :: sent(:)     !< (0:nranks − 1) particles migrated to each rank (increment ends)
