@@ -32,10 +32,14 @@ module mpm_grid
 
 contains
 
-  subroutine grid_init(g, ndim, lo, hi, h)
+  !> The whole grid from lo to hi with cell h. With nodes = .false. only its geometry (sizes,
+  !> positions): a spatially decomposed run allocates its held box only (mpm_halo domain_regrid),
+  !> so no rank's peak memory holds the whole grid's node arrays.
+  subroutine grid_init(g, ndim, lo, hi, h, nodes)
     type(grid_t), intent(out) :: g
     integer, intent(in) :: ndim
     real(dp), intent(in) :: lo(3), hi(3), h
+    logical, intent(in), optional :: nodes
     integer :: k
 
     g%ndim = ndim
@@ -48,6 +52,9 @@ contains
     end do
     ! the reader refused grids beyond 2147483647 nodes (scene_mpm check_mpm_size): nn fits
     g%nn = int(grid_node_count(g%n))
+    if (present(nodes)) then
+       if (.not. nodes) return
+    end if
     allocate (g%mass(g%nn), g%mass_own(g%nn), g%mom(ndim, g%nn), g%force(ndim, g%nn), g%v_old(ndim, g%nn), &
          g%v_new(ndim, g%nn), g%active(g%nn))
     call grid_reset(g)

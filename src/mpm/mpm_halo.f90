@@ -19,7 +19,7 @@ module mpm_halo
   implicit none
   private
 
-  public :: halo_sum_p2g, halo_sum_momentum, owned_mass, sum_increment_accounts, owned_grid
+  public :: halo_sum_p2g, halo_sum_momentum, owned_mass, sum_increment_accounts
   public :: domain_regrid, local_corners, whole_grid_shape
 
 contains
@@ -156,37 +156,6 @@ contains
     st%e_walls = e_walls0 + buf(3 * nw + 1)
     st%e_damping = e_damping0 + buf(3 * nw + 2)
   end subroutine sum_increment_accounts
-
-  !> The grid a field frame shows: every node's mass and v_new as its owner holds them (the
-  !> other ranks add zeros, so the values are the owner's bits). Collective. Why a sum over the
-  !> whole grid: the frame's writer takes the whole grid from rank 0; it happens at frames only.
-  subroutine owned_grid(st, gw)
-    type(mpm_state_t), intent(in) :: st
-    type(grid_t), intent(out) :: gw
-    real(dp), allocatable :: buf(:)
-    integer :: nn, nd, i, j, idx(3), r
-
-    gw = whole_grid_shape(st)
-    nn = gw%nn
-    nd = st%nd
-    allocate (buf(nn * (1 + nd)), source=0.0_dp)
-    do i = 1, st%g%nn
-       if (.not. st%dom%owned(i)) cycle
-       ! the whole grid's node of this rank's node i
-       r = i - 1
-       idx(1) = mod(r, st%g%n(1))
-       r = r / st%g%n(1)
-       idx(2) = mod(r, st%g%n(2))
-       idx(3) = r / st%g%n(2)
-       idx = idx + st%g%offset
-       j = 1 + idx(1) + gw%n(1) * (idx(2) + gw%n(2) * idx(3))
-       buf(j) = st%g%mass(i)
-       buf(nn + nd * (j - 1) + 1:nn + nd * j) = st%g%v_new(:, i)
-    end do
-    call comm_sum(st%comm, buf)
-    allocate (gw%mass(nn), source=buf(1:nn))
-    allocate (gw%v_new(nd, nn), source=reshape(buf(nn + 1:), [nd, nn]))
-  end subroutine owned_grid
 
   !> The whole grid's sizes and position (no node arrays): what the field output describes.
   function whole_grid_shape(st) result(gw)

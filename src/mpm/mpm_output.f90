@@ -115,7 +115,7 @@ contains
   end subroutine mpm_writer_open
 
   !> One frame: every particle of this rank's blocks (in block order) and the grid. Collective.
-  subroutine mpm_writer_frame(wr, m, blocks, nblocks, g, step, increment, step_time, total_time)
+  subroutine mpm_writer_frame(wr, m, blocks, nblocks, g, step, increment, step_time, total_time, owned_lo, owned_hi)
     type(mpm_writer_t), intent(inout) :: wr
     type(model_t), intent(in) :: m
     type(particle_block_t), intent(in) :: blocks(:)
@@ -123,6 +123,9 @@ contains
     type(grid_t), intent(in) :: g
     integer, intent(in) :: step, increment
     real(dp), intent(in) :: step_time, total_time
+    !> a decomposed grid: g is the rank's held box and these its owned nodes (whole-grid node
+    !> indices, 0-based, inclusive; hi < lo: none), which this rank writes (mpm_domain)
+    integer, intent(in), optional :: owned_lo(3), owned_hi(3)
     integer :: n, ib, p, r, nd, nsv, nfv, j
     real(dp), allocatable :: xyz(:, :), vel(:, :), s(:, :), le(:, :), dens(:), mass(:), vol(:), sdv(:, :)
     real(dp), allocatable :: fv(:, :), temp(:)
@@ -182,13 +185,46 @@ contains
        call point_writer_scalar(wr%points, 'FV' // int_to_str(j), fv(:, j))
     end do
     if (wr%req%temp) call point_writer_scalar(wr%points, 'TEMP', temp)
-    allocate (gv(3, g%nn))
-    gv = 0
-    gv(1:nd, :) = g%v_new
-    call point_writer_grid_field(wr%points, 'mass', g%mass, 1)
-    call point_writer_grid_field(wr%points, 'V', reshape(gv, [3 * g%nn]), 3)
+    if (present(owned_lo) .and. present(owned_hi)) then
+       call write_owned_grid(wr, g, owned_lo, owned_hi)
+    else
+       allocate (gv(3, g%nn))
+       gv = 0
+       gv(1:nd, :) = g%v_new
+       call point_writer_grid_field(wr%points, 'mass', g%mass, 1)
+       call point_writer_grid_field(wr%points, 'V', reshape(gv, [3 * g%nn]), 3)
+    end if
     call point_writer_end_frame(wr%points)
   end subroutine mpm_writer_frame
+
+  !> The grid part of a frame of a decomposed grid: each rank writes the mass and V of the
+  !> nodes it owns (the owner's values: the halo sums made them whole there), a box of the
+  !> whole grid's datasets. Collective.
+  subroutine write_owned_grid(wr, g, owned_lo, owned_hi)
+    type(mpm_writer_t), intent(inout) :: wr
+    type(grid_t), intent(in) :: g
+    integer, intent(in) :: owned_lo(3), owned_hi(3)
+    real(dp), allocatable :: mass(:), v(:, :)
+    integer :: count(3), i, j, k, r, node, nd
+
+    nd = wr%ndim
+    count = max(0, owned_hi - owned_lo + 1)
+    allocate (mass(product(count)), v(3, product(count)))
+    v = 0
+    r = 0
+    do k = owned_lo(3), owned_hi(3)
+       do j = owned_lo(2), owned_hi(2)
+          do i = owned_lo(1), owned_hi(1)
+             r = r + 1
+             node = 1 + (i - g%offset(1)) + g%n(1) * ((j - g%offset(2)) + g%n(2) * (k - g%offset(3)))
+             mass(r) = g%mass(node)
+             v(1:nd, r) = g%v_new(:, node)
+          end do
+       end do
+    end do
+    call point_writer_grid_field(wr%points, 'mass', mass, 1, owned_lo, count)
+    call point_writer_grid_field(wr%points, 'V', reshape(v, [3 * size(mass)]), 3, owned_lo, count)
+  end subroutine write_owned_grid
 
   !> Frames written so far (what a checkpoint records).
   pure integer function mpm_writer_frame_count(wr)

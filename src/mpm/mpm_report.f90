@@ -8,8 +8,7 @@ module mpm_report
   use mpm_state, only: mpm_state_t, sum_over_ranks, max_over_ranks
   use output_effects, only: effects_t
   use mpm_output, only: mpm_writer_t, mpm_writer_frame
-  use mpm_grid, only: grid_t
-  use mpm_halo, only: owned_grid
+  use mpm_domain, only: owned_range
   use parallel_comm, only: comm_max, comm_sum
   use output_history, only: history_t, history_row
   implicit none
@@ -35,12 +34,13 @@ contains
     integer, intent(in) :: step
     real(dp), intent(in) :: step_time
 
-    type(grid_t) :: gw
+    integer :: olo(3), ohi(3)
 
     if (st%dom%on) then
-       ! a decomposed grid: each node's mass and V from its owner (mpm_halo)
-       call owned_grid(st, gw)
-       call mpm_writer_frame(wr, m, st%blocks, st%nblocks, gw, step, st%increment, step_time, st%total_time)
+       ! a decomposed grid: each rank writes the nodes it owns (mpm_domain)
+       call owned_range(st%dom, st%rank, olo, ohi)
+       call mpm_writer_frame(wr, m, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time, &
+            olo, ohi)
     else
        call mpm_writer_frame(wr, m, st%blocks, st%nblocks, st%g, step, st%increment, step_time, st%total_time)
     end if

@@ -38,8 +38,9 @@ contains
     integer :: k, s
     logical :: spatial
 
-    call setup_state(m, st)
     spatial = st%nranks > 1 .and. m%mpm%decomposition == decomposition_spatial
+    ! spatial: the whole grid's geometry only; its node arrays are the held box's (domain_regrid)
+    call setup_state(m, st, grid_nodes=.not. spatial)
     associate (mpm => m%mpm)
       allocate (st%wall_nodes(size(mpm%walls)), st%wall_force(3, size(mpm%walls)))
       allocate (st%wall_impulse(3, size(mpm%walls)), st%wall_force_row(3, size(mpm%walls)))
@@ -140,9 +141,10 @@ contains
 
   !> Sizes (dimension, stress components, stencil), the grid, the materials' moduli and the
   !> full-block VUMAT work set; no particles yet.
-  subroutine setup_state(m, st)
+  subroutine setup_state(m, st, grid_nodes)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
+    logical, intent(in) :: grid_nodes   !< allocate the whole grid's node arrays (mpm_grid grid_init)
     integer :: k, nsv, nfv
 
     st%nd = m%mpm%ndim
@@ -154,7 +156,7 @@ contains
        st%nshr = 3
     end if
     st%nsup = stencil_nodes_per_direction(m%mpm%shape)
-    call grid_init(st%g, st%nd, m%mpm%lo, m%mpm%hi, m%mpm%cell)
+    call grid_init(st%g, st%nd, m%mpm%lo, m%mpm%hi, m%mpm%cell, nodes=grid_nodes)
     allocate (st%modulus(m%n_materials), st%needs_kinematics(m%n_materials))
     nsv = 1
     nfv = 1

@@ -42,7 +42,7 @@ module output_hdf5
   use output_collective, only: agree_on_error
   use output_xdmf, only: xdmf_mesh_t, xdmf_frame_t, xdmf_write, xdmf_add_attribute, &
        xdmf_center_node, xdmf_center_cell
-  use output_hdf5_basics, only: hdf5_error_context, check, create_dataset, write_attr_int, &
+  use output_hdf5_basics, only: hdf5_error_context, check, collective_transfer, create_dataset, write_attr_int, &
        write_attr_real, write_attr_string
   use output_hdf5_rows, only: write_rows_real, write_rows_int
   use output_hdf5_frames, only: reopen_frames, frame_path, new_xdmf_frame, &
@@ -188,10 +188,7 @@ contains
        call check(hdferr, 'creating the file')
     end if
     call h5pclose_f(fapl, hdferr)
-    call h5pcreate_f(H5P_DATASET_XFER_F, w%xfer, hdferr)
-    call check(hdferr, 'creating the transfer property list')
-    call h5pset_dxpl_mpio_f(w%xfer, H5FD_MPIO_COLLECTIVE_F, hdferr)
-    call check(hdferr, 'h5pset_dxpl_mpio')
+    call collective_transfer(w%xfer)
     w%is_open = .true.
 
     w%mesh%h5_file = base_name(w%h5_path)

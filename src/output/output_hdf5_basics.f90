@@ -2,14 +2,14 @@
 !> dataspaces of a block of rows, and the stop on a failed HDF5 call. A failure names the file
 !> given by the last hdf5_error_context call (the low-level helpers have no writer at hand).
 module output_hdf5_basics
-  use, intrinsic :: iso_c_binding, only: c_loc, c_char, c_ptr
+  use, intrinsic :: iso_c_binding, only: c_loc, c_char, c_ptr, c_int, c_int64_t
   use hdf5
   use base_kinds, only: dp
   use error_report, only: raise_error
   implicit none
   private
 
-  public :: hdf5_error_context, check
+  public :: hdf5_error_context, check, collective_transfer
   public :: dataset_space, create_dataset, create_shaped_dataset, dataset_rows, block_spaces
   public :: write_attr_int, write_attr_real, write_attr_string, read_attr_real, read_attr_string
   public :: write_attr_ints, write_attr_reals, read_attr_ints, read_attr_reals
@@ -18,7 +18,37 @@ module output_hdf5_basics
   !> output_hdf5): such failures are fatal.
   character(len=:), allocatable :: error_context
 
+  interface
+     !> HDF5's C call (no Fortran wrapper in HDF5 1.10): H5FD_MPIO_INDIVIDUAL_IO = 1
+     integer(c_int) function h5pset_dxpl_mpio_collective_opt(dxpl, mode) &
+          bind(c, name='H5Pset_dxpl_mpio_collective_opt')
+       import :: c_int, c_int64_t
+       integer(c_int64_t), value :: dxpl   !< hid_t: int64_t since HDF5 1.10
+       integer(c_int), value :: mode
+     end function h5pset_dxpl_mpio_collective_opt
+  end interface
+
 contains
+
+  !> The transfer property list of a field file's writes: collective HDF5 calls (every rank
+  !> takes part in each, the metadata stay consistent) whose raw data each rank writes to the
+  !> file itself (MPI-IO individual I/O). Why not MPI-IO's collective buffering: its
+  !> aggregator (rank 0 on one machine) gathers every rank's part of a dataset before writing,
+  !> so rank 0's memory held the whole particle set at every frame (scripts/bench_memory.py:
+  !> data per rank on 4 ranks 0.33 of one rank's with it, 0.26 without). Each rank's part is one
+  !> contiguous block of rows (output_hdf5_rows) or one box of grid nodes: little to gain from
+  !> aggregating.
+  subroutine collective_transfer(xfer)
+    integer(hid_t), intent(out) :: xfer
+    integer :: hdferr
+
+    call h5pcreate_f(H5P_DATASET_XFER_F, xfer, hdferr)
+    call check(hdferr, 'creating the transfer property list')
+    call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, hdferr)
+    call check(hdferr, 'h5pset_dxpl_mpio')
+    hdferr = int(h5pset_dxpl_mpio_collective_opt(int(xfer, c_int64_t), 1_c_int))
+    call check(hdferr, 'h5pset_dxpl_mpio_collective_opt')
+  end subroutine collective_transfer
 
   !> Name `path` in the messages of HDF5 calls that fail from now on.
   subroutine hdf5_error_context(path)

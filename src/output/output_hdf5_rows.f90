@@ -13,7 +13,7 @@ module output_hdf5_rows
   implicit none
   private
 
-  public :: write_rows_real, write_rows_int, write_whole_real
+  public :: write_rows_real, write_rows_int, write_whole_real, write_box_real
 
 contains
 
@@ -221,5 +221,54 @@ contains
     call h5sclose_f(mem_space, hdferr)
     call h5sclose_f(file_space, hdferr)
   end subroutine write_whole_real
+
+  !> Write this rank's box of a node dataset of dimensions ([ncomp,] n1, n2, n3): the nodes
+  !> offset .. offset + count − 1 (0-based, per axis), values ordered components fastest, then
+  !> the box's nodes with axis 1 fastest. Collective; a rank with an empty box writes nothing.
+  !> Why boxes: a decomposed grid's ranks own disjoint boxes that tile it, so no rank holds the
+  !> whole grid to write it.
+  subroutine write_box_real(xfer, dset, values, ncomp, offset, count)
+    integer(hid_t), intent(in) :: xfer       !< collective transfer property list
+    integer(hid_t), intent(in) :: dset
+    real(dp), intent(in), target :: values(:)
+    integer, intent(in) :: ncomp
+    integer, intent(in) :: offset(3), count(3)
+    real(dp), target :: idle(1)
+    integer(hsize_t) :: start(4), extent(4)
+    integer(hid_t) :: file_space, mem_space
+    integer :: hdferr, rank
+
+    call h5dget_space_f(dset, file_space, hdferr)
+    call check(hdferr, 'getting a file dataspace')
+    call h5screate_simple_f(1, [int(max(size(values), 1), hsize_t)], mem_space, hdferr)
+    call check(hdferr, 'creating a memory dataspace')
+    idle = 0.0_dp
+    if (any(count <= 0) .or. size(values) == 0) then
+       call h5sselect_none_f(file_space, hdferr)
+       call h5sselect_none_f(mem_space, hdferr)
+       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(idle), hdferr, mem_space, file_space, xfer)
+    else
+       if (size(values) /= ncomp * product(count)) call raise_error('output_hdf5_rows', 0, &
+            'a grid box of ' // int_to_str(size(values)) // ' values; expected ' // &
+            int_to_str(ncomp * product(count)))
+       if (ncomp == 1) then
+          rank = 3
+          start(1:3) = int(offset, hsize_t)
+          extent(1:3) = int(count, hsize_t)
+       else
+          rank = 4
+          start(1) = 0
+          extent(1) = int(ncomp, hsize_t)
+          start(2:4) = int(offset, hsize_t)
+          extent(2:4) = int(count, hsize_t)
+       end if
+       call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start(1:rank), extent(1:rank), hdferr)
+       call check(hdferr, 'selecting a grid box')
+       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(values), hdferr, mem_space, file_space, xfer)
+    end if
+    call check(hdferr, 'writing a dataset')
+    call h5sclose_f(mem_space, hdferr)
+    call h5sclose_f(file_space, hdferr)
+  end subroutine write_box_real
 
 end module output_hdf5_rows

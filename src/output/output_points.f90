@@ -29,9 +29,9 @@ module output_points
   use output_files, only: base_name, file_exists
   use output_collective, only: agree_on_error
   use output_xdmf, only: xdmf_mesh_t, xdmf_frame_t, xdmf_write, xdmf_add_attribute, xdmf_center_node
-  use output_hdf5_basics, only: hdf5_error_context, check, create_shaped_dataset, write_attr_string, &
-       write_attr_ints, write_attr_reals, read_attr_ints, read_attr_reals
-  use output_hdf5_rows, only: write_rows_real, write_rows_int, write_whole_real
+  use output_hdf5_basics, only: hdf5_error_context, check, collective_transfer, create_shaped_dataset, &
+       write_attr_string, write_attr_ints, write_attr_reals, read_attr_ints, read_attr_reals
+  use output_hdf5_rows, only: write_rows_real, write_rows_int, write_whole_real, write_box_real
   use output_hdf5_frames, only: frame_sequence, grow_frames
   implicit none
   private
@@ -150,9 +150,7 @@ contains
        call h5gclose_f(grp, hdferr)
     end if
     call h5pclose_f(fapl, hdferr)
-    call h5pcreate_f(H5P_DATASET_XFER_F, w%xfer, hdferr)
-    call h5pset_dxpl_mpio_f(w%xfer, H5FD_MPIO_COLLECTIVE_F, hdferr)
-    call check(hdferr, 'h5pset_dxpl_mpio')
+    call collective_transfer(w%xfer)
     call h5fflush_f(w%file, H5F_SCOPE_GLOBAL_F, hdferr)
     call rewrite_xdmf(w, err)
   end subroutine point_writer_open
@@ -237,12 +235,15 @@ contains
   end subroutine point_writer_ints
 
   !> A nodal field of the grid, values(ncomp * nodes) with the components fastest, then x, y, z
-  !> (every rank holds the same; rank 0 writes): dataset (nz, ny, nx[, ncomp]).
-  subroutine point_writer_grid_field(w, name, values, ncomp)
+  !> (rank 0 writes the whole grid, or each rank its box): dataset (nz, ny, nx[, ncomp]).
+  subroutine point_writer_grid_field(w, name, values, ncomp, box_offset, box_count)
     type(point_writer_t), intent(inout) :: w
     character(len=*), intent(in) :: name
     real(dp), intent(in) :: values(:)
     integer, intent(in) :: ncomp
+    !> with these, values is this rank's box of nodes (write_box_real); without, rank 0's
+    !> values are the whole grid
+    integer, intent(in), optional :: box_offset(3), box_count(3)
     integer(hsize_t), allocatable :: dims(:)
     integer(hid_t) :: dset
     integer :: hdferr
@@ -255,7 +256,11 @@ contains
        allocate (dims, source=[int(ncomp, hsize_t), int(w%grid_mesh%grid_n, hsize_t)])
     end if
     call create_shaped_dataset(w%grid, name, H5T_IEEE_F64LE, dims, dset)
-    call write_whole_real(w%xfer, dset, values, w%rank == 0)
+    if (present(box_offset) .and. present(box_count)) then
+       call write_box_real(w%xfer, dset, values, ncomp, box_offset, box_count)
+    else
+       call write_whole_real(w%xfer, dset, values, w%rank == 0)
+    end if
     call h5dclose_f(dset, hdferr)
   end subroutine point_writer_grid_field
 
