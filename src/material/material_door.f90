@@ -22,7 +22,8 @@
 module material_door
   use base_kinds, only: dp
   use error_report, only: error_t, raise_error
-  use abaqus_host, only: host_set_block, host_set_block_extra, host_set_block_moduli, host_set_block_material
+  use abaqus_host, only: host_set_block, host_set_block_extra, host_set_block_moduli, host_set_block_material, &
+       host_clear_block
   use material_props, only: model_from_name, model_mohr_coulomb, model_drucker_prager
   use model_materials, only: material_t
   use model_sets, only: name_length
@@ -274,8 +275,10 @@ contains
     integer, intent(in) :: i0, i1, first, ncomp, nshr
     integer, intent(in) :: elem_number(:)
     real(dp), intent(in) :: step_time, total_time, dt
-    real(dp), intent(in) :: char_length(:), stress(:, :), log_strain(:, :), state(:, :)
-    type(vumat_work_t), intent(inout) :: w
+    real(dp), intent(in) :: char_length(:)
+    ! TARGET: the host points at them while the VUSDFLD runs (vgetvrm; abaqus_host)
+    real(dp), intent(in), target :: stress(:, :), log_strain(:, :), state(:, :)
+    type(vumat_work_t), intent(inout), target :: w
     procedure(), pointer :: usdfld
     integer :: n, last, ns, nf, model, j0, nsu
     real(dp) :: lambda, shear
@@ -311,6 +314,7 @@ contains
             char_length(i0:i1), mat%props, state(i0:i1, j0:ns), w%state_mid(first:last, j0:ns), &
             w%field_new(first:last, 1:nf))
     end if
+    call host_clear_block()
   end subroutine call_field_piece
 
   !> Stop with the material, the element or particle and the time when a user's VUMAT returned

@@ -28,9 +28,11 @@ contains
     character(len=80) :: cmname
     integer :: ndir, nshr, ncomp, nprops, inc, k
     real(dp), allocatable :: props(:)
-    real(dp) :: strain_inc(nblock, 6), stress_old(nblock, 6), stress_new(nblock, 6)
+    real(dp) :: strain_inc(nblock, 6), stress_new(nblock, 6)
+    real(dp), target :: stress_old(nblock, 6)   ! the host points at it (host_set_block)
     real(dp) :: state_old(nblock, nstatev), state_new(nblock, nstatev)
-    real(dp) :: field_old(nblock, nfieldv), field_new(nblock, nfieldv), log_strain(nblock, 6)
+    real(dp) :: field_old(nblock, nfieldv), field_new(nblock, nfieldv)
+    real(dp), target :: log_strain(nblock, 6)
     real(dp) :: e_int_old(nblock), e_int_new(nblock), e_inel_old(nblock), e_inel_new(nblock)
     real(dp) :: density(nblock), coord(nblock, 3), char_length(nblock), rel_spin(nblock, 3)
     real(dp) :: temp(nblock), stretch(nblock, 6), defgrad(nblock, 9), direct(nblock, 3, 3), tmat(nblock, 3, 3)
