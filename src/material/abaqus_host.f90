@@ -7,8 +7,8 @@
 !> until `host_clear_block` after the VUSDFLD call. Why pointers, not copies: the copies (and the
 !> state's reallocation), made for every block whether or not the VUSDFLD asks for a key, go;
 !> `vgetvrm` copies only what is asked (perf, ch. 4 discharge on 1 rank: memcpy samples per
-!> increment −8 %, about 1 % of the run; results the same bytes). The caller's arrays must stay in place until the clear
-!> (TARGET dummies of the caller, no temporary), and
+!> increment −8 %, about 1 % of the run; results the same bytes). The caller's arrays must stay
+!> in place until the clear (TARGET dummies of the caller, no temporary), and
 !> `host_set_block_moduli` the material's isotropic moduli (PE = LE − C⁻¹:σ for any material),
 !> `host_set_block_material` whose block it is (messages); the external `vgetvrm` reads them back
 !> in Abaqus's flat layout (docs/user_subroutines.md lists the keys).
