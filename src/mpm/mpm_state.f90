@@ -28,6 +28,11 @@ module mpm_state
        fx_side_friction = fx_p2g + 11, fx_exchange = fx_p2g + 12, fx_migration = fx_p2g + 13, &
        fx_nonlocal = fx_p2g + 14
 
+  !> Work sets for partial blocks a rank keeps (mpm_state_t%work): more than the partial blocks
+  !> a rank usually holds at once (1-8 in the ch. 4 discharge); a work set is at most
+  !> particle_block_size rows (about 0.1 MB in 2D).
+  integer, parameter, public :: partial_work_sets = 16
+
   !> Everything the run keeps. Per-rank partial values (sum over ranks when reported) are
   !> marked "rank"; the rest is the same on every rank.
   type, public :: mpm_state_t
@@ -51,11 +56,16 @@ module mpm_state
      real(dp), allocatable :: gpack(:, :)
      real(dp), allocatable :: modulus(:)             !< per material: λ + 2G (packaging call)
      logical, allocatable :: needs_kinematics(:)     !< per material: user VUMAT reads F, U
-     !> VUMAT work sets: work(1) has particle_block_size rows (full blocks), work(2) the rows of
-     !> the last partial block (made again when a block of another count comes). Why: with
-     !> exactly nb rows every (1:nb, ...) section the door passes is the whole, contiguous array
-     !> (no pack/unpack copies) and the new stress and state are swapped in, not copied.
-     type(vumat_work_t) :: work(2)
+     !> VUMAT work sets: work(1) has particle_block_size rows (full blocks), work(2:) the rows of
+     !> partial blocks, one set per count (work_rows), made when a count comes that no set has.
+     !> Why exactly nb rows: every (1:nb, ...) section the door passes is the whole, contiguous
+     !> array (no pack/unpack copies) and the new stress and state are swapped in, not copied.
+     !> Why several: a rank holds several partial blocks of different counts that keep their
+     !> counts for many increments (migration leaves holes, the sort keeps counts); with one
+     !> partial set they took turns re-making it at every increment (docs/scaling.md).
+     type(vumat_work_t) :: work(1 + partial_work_sets)
+     integer :: work_rows(1 + partial_work_sets) = 0  !< rows of each set (0: not made)
+     integer :: work_replace = 1                      !< the partial set a miss re-makes when all are made
      integer :: work_statev = 1, work_fieldv = 1     !< columns of the work sets (largest of the materials)
      integer :: next_number = 0
      ! mass bookkeeping (exact: particle masses never change)

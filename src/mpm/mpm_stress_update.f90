@@ -119,23 +119,37 @@ contains
   !> data the VUSDFLD and the VUMAT read from it: coordMp (the particle's position, third
   !> column 0 in 2D; only for the materials that read it) and tempOld, tempNew (the material's
   !> particle temperature at t_n and t_n+1, driver_temperature).
+  !> A partial block takes the set made for its count; when no set has it, an unmade set, or else
+  !> the sets are re-made in turn. Which set serves a block does not change its results: what the
+  !> material reads from a set is written before the call (here, stress_update, the door) or is
+  !> the same in every set of that count (U = F = I and zero coordinates where not written).
   subroutine block_work_set(m, st, b, iw)
     type(model_t), intent(in) :: m
     type(mpm_state_t), intent(inout) :: st
     type(particle_block_t), intent(in) :: b
     integer, intent(out) :: iw
-    integer :: nb
+    integer :: nb, k
     real(dp) :: dt
 
     nb = b%count
     dt = st%dt
     iw = 1
     if (nb /= particle_block_size) then
-       iw = 2
-       if (.not. allocated(st%work(2)%temp)) then
-          call material_work_init(st, st%work(2), nb)
-       else if (size(st%work(2)%temp) /= nb) then
-          call material_work_init(st, st%work(2), nb)
+       iw = 0
+       do k = 2, size(st%work)
+          if (st%work_rows(k) == nb .or. st%work_rows(k) == 0) then
+             iw = k
+             exit
+          end if
+       end do
+       if (iw == 0) then
+          st%work_replace = 1 + mod(st%work_replace, size(st%work) - 1)
+          iw = 1 + st%work_replace
+          st%work_rows(iw) = 0
+       end if
+       if (st%work_rows(iw) == 0) then
+          call material_work_init(st, st%work(iw), nb)
+          st%work_rows(iw) = nb
        end if
     end if
     if (st%needs_kinematics(b%material)) st%work(iw)%coord(1:nb, 1:st%nd) = b%x(1:nb, 1:st%nd)
