@@ -201,26 +201,43 @@ contains
     integer(hid_t), intent(in) :: dset
     real(dp), intent(in), target :: values(:)
     logical, intent(in) :: writer
+    integer(hid_t) :: file_space, mem_space
+    integer :: hdferr
+
+    if (.not. (writer .and. size(values) > 0)) then
+       call write_nothing(xfer, dset)
+       return
+    end if
+    call h5dget_space_f(dset, file_space, hdferr)
+    call check(hdferr, 'getting a file dataspace')
+    call h5screate_simple_f(1, [int(size(values), hsize_t)], mem_space, hdferr)
+    call check(hdferr, 'creating a memory dataspace')
+    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(values), hdferr, mem_space, file_space, xfer)
+    call check(hdferr, 'writing a dataset')
+    call h5sclose_f(mem_space, hdferr)
+    call h5sclose_f(file_space, hdferr)
+  end subroutine write_whole_real
+
+  !> This rank's part in a collective write of dset when it has nothing to write: empty
+  !> selections in the file and in a one-value memory space (a buffer still needs an address).
+  subroutine write_nothing(xfer, dset)
+    integer(hid_t), intent(in) :: xfer, dset
     real(dp), target :: idle(1)
     integer(hid_t) :: file_space, mem_space
     integer :: hdferr
 
     call h5dget_space_f(dset, file_space, hdferr)
     call check(hdferr, 'getting a file dataspace')
-    call h5screate_simple_f(1, [int(max(size(values), 1), hsize_t)], mem_space, hdferr)
+    call h5screate_simple_f(1, [1_hsize_t], mem_space, hdferr)
     call check(hdferr, 'creating a memory dataspace')
     idle = 0.0_dp
-    if (writer .and. size(values) > 0) then
-       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(values), hdferr, mem_space, file_space, xfer)
-    else
-       call h5sselect_none_f(file_space, hdferr)
-       call h5sselect_none_f(mem_space, hdferr)
-       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(idle), hdferr, mem_space, file_space, xfer)
-    end if
+    call h5sselect_none_f(file_space, hdferr)
+    call h5sselect_none_f(mem_space, hdferr)
+    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(idle), hdferr, mem_space, file_space, xfer)
     call check(hdferr, 'writing a dataset')
     call h5sclose_f(mem_space, hdferr)
     call h5sclose_f(file_space, hdferr)
-  end subroutine write_whole_real
+  end subroutine write_nothing
 
   !> Write this rank's box of a node dataset of dimensions ([ncomp,] n1, n2, n3): the nodes
   !> offset .. offset + count − 1 (0-based, per axis), values ordered components fastest, then
@@ -233,39 +250,35 @@ contains
     real(dp), intent(in), target :: values(:)
     integer, intent(in) :: ncomp
     integer, intent(in) :: offset(3), count(3)
-    real(dp), target :: idle(1)
     integer(hsize_t) :: start(4), extent(4)
     integer(hid_t) :: file_space, mem_space
     integer :: hdferr, rank
 
+    if (any(count <= 0) .or. size(values) == 0) then
+       call write_nothing(xfer, dset)
+       return
+    end if
+    if (size(values) /= ncomp * product(count)) call raise_error('output_hdf5_rows', 0, &
+         'a grid box of ' // int_to_str(size(values)) // ' values; expected ' // &
+         int_to_str(ncomp * product(count)))
     call h5dget_space_f(dset, file_space, hdferr)
     call check(hdferr, 'getting a file dataspace')
-    call h5screate_simple_f(1, [int(max(size(values), 1), hsize_t)], mem_space, hdferr)
+    call h5screate_simple_f(1, [int(size(values), hsize_t)], mem_space, hdferr)
     call check(hdferr, 'creating a memory dataspace')
-    idle = 0.0_dp
-    if (any(count <= 0) .or. size(values) == 0) then
-       call h5sselect_none_f(file_space, hdferr)
-       call h5sselect_none_f(mem_space, hdferr)
-       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(idle), hdferr, mem_space, file_space, xfer)
+    if (ncomp == 1) then
+       rank = 3
+       start(1:3) = int(offset, hsize_t)
+       extent(1:3) = int(count, hsize_t)
     else
-       if (size(values) /= ncomp * product(count)) call raise_error('output_hdf5_rows', 0, &
-            'a grid box of ' // int_to_str(size(values)) // ' values; expected ' // &
-            int_to_str(ncomp * product(count)))
-       if (ncomp == 1) then
-          rank = 3
-          start(1:3) = int(offset, hsize_t)
-          extent(1:3) = int(count, hsize_t)
-       else
-          rank = 4
-          start(1) = 0
-          extent(1) = int(ncomp, hsize_t)
-          start(2:4) = int(offset, hsize_t)
-          extent(2:4) = int(count, hsize_t)
-       end if
-       call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start(1:rank), extent(1:rank), hdferr)
-       call check(hdferr, 'selecting a grid box')
-       call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(values), hdferr, mem_space, file_space, xfer)
+       rank = 4
+       start(1) = 0
+       extent(1) = int(ncomp, hsize_t)
+       start(2:4) = int(offset, hsize_t)
+       extent(2:4) = int(count, hsize_t)
     end if
+    call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start(1:rank), extent(1:rank), hdferr)
+    call check(hdferr, 'selecting a grid box')
+    call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, c_loc(values), hdferr, mem_space, file_space, xfer)
     call check(hdferr, 'writing a dataset')
     call h5sclose_f(mem_space, hdferr)
     call h5sclose_f(file_space, hdferr)
