@@ -1,9 +1,10 @@
 !> The material-point keywords of a scene (bulkflow's own; docs/keywords.md, section "MPM"):
 !>
 !>   *MPM GRID, CELL=h [, SHAPE=GIMP|LINEAR]        data: lo corner; hi corner (2 or 3 values)
-!>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a] [, SORT=n]   model data or in a step; carries over
-!>   *MPM SIDE FRICTION, GAP=t, FRICTION=μw         2D, model data or in a step; carries over
+!>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a] [, SORT=n] [, MAX DILATION=j]
+!>                                                  model data or in a step; carries over
 !>     [, DECOMPOSITION=REPLICATED|SPATIAL] [, REBALANCE=r]   model data only (MPI ranks)
+!>   *MPM SIDE FRICTION, GAP=t, FRICTION=μw         2D, model data or in a step; carries over
 !>   *PARTICLES, MATERIAL=name [, PPC=n] [, TYPE=BOX|POLYGON] [, Z1=, Z2=] [, VX=, VY=, VZ=]
 !>                                                  data: BOX lo; hi  |  POLYGON x, y per line
 !>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, OP=DELETE]
@@ -310,21 +311,27 @@ contains
     type(keyword_block_t), intent(in) :: blk
     type(mpm_step_t), intent(inout) :: c
     type(error_t), intent(inout) :: err
-    real(dp) :: flip, cfl, damping
+    real(dp) :: flip, cfl, damping, max_dilation
     integer :: sort
 
-    call blk%check_params([character(len=13) :: 'FLIP', 'CFL', 'DAMPING', 'SORT', 'DECOMPOSITION', 'REBALANCE'], err)
+    call blk%check_params([character(len=13) :: 'FLIP', 'CFL', 'DAMPING', 'SORT', 'DECOMPOSITION', 'REBALANCE', &
+         'MAX DILATION'], err)
     if (.not. err%raised) call blk%get_real('FLIP', flip, err, default=c%flip, minimum=0.0_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('CFL', cfl, err, default=c%cfl, minimum=1.0e-3_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('DAMPING', damping, err, default=c%damping, minimum=0.0_dp, &
          maximum=0.99_dp)
     if (.not. err%raised) call blk%get_integer('SORT', sort, err, default=c%sort, minimum=0)
+    if (.not. err%raised) call blk%get_real('MAX DILATION', max_dilation, err, default=c%max_dilation, &
+         minimum=0.0_dp)
+    if (.not. err%raised .and. max_dilation > 0 .and. max_dilation < 1) call blk%fail('*MPM CONTROLS: MAX DILATION=' // &
+         rtoa(max_dilation) // '; expected 0 (off) or a volume ratio V/V0 >= 1', err)
     if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
     if (err%raised) return
     c%flip = flip
     c%cfl = cfl
     c%damping = damping
     c%sort = sort
+    c%max_dilation = max_dilation
   end subroutine read_controls
 
   subroutine material_param(blk, model, k, err)

@@ -71,6 +71,9 @@ module mpm_scene
      integer :: sort = 0
      !> *MPM SIDE FRICTION: Coulomb μw of the front and back walls a gap side_gap apart (2D; 0: off)
      real(dp) :: side_friction = 0, side_gap = 0
+     !> *MPM CONTROLS, MAX DILATION=j: a particle's volume ratio J = det F is held at most j by an
+     !> isotropic scaling of its F (in plane in 2D) after its stress update (0: off; docs/keywords.md)
+     real(dp) :: max_dilation = 0
      type(mpm_inflow_t) :: inflow
   end type mpm_step_t
 

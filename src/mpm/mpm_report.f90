@@ -184,7 +184,7 @@ contains
        g(2) = g(2) + st%blocks(ib)%count
     end do
     g(3:8) = [st%mass_out, real(st%n_out, dp), st%w_external, real(st%n_guarded, dp), &
-         real(st%particle_steps, dp), 0.0_dp]
+         real(st%particle_steps, dp), real(st%n_dilation_held, dp)]
     call sum_over_ranks(st, g)
     nmax = 0
     if (st%dom%on) then
@@ -220,6 +220,8 @@ contains
     if (side_friction_on(m)) write (output_unit, '(a,2es13.5)') '  front and back walls (side friction) force:', &
          st%side_force(1:2)
     if (g(6) > 0) write (output_unit, '(a,i0)') '  particles put back onto walls: ', nint(g(6))
+    if (any(m%mpm%steps%max_dilation > 0)) write (output_unit, '(a,i0,a)') '  particle-increments held at MAX DILATION: ', &
+         nint(g(8), int64), ' (since this run or its restart began)'
     rate = g(7) / max(st%loop_seconds, 1.0e-9_dp)
     write (output_unit, '(a,i0,a,es11.4,a,f10.3,a,i0,a,es11.4,a)') '  throughput ', nint(g(7), int64), &
          ' particle-steps, ', rate, ' per second (time loop ', st%loop_seconds, ' s, ', st%nranks, &

@@ -13,7 +13,7 @@ module mpm_setup
   use mpm_halo, only: domain_regrid
   use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_kinematics, fx_material, &
        fx_user_field, fx_gravity, fx_damping, fx_walls, fx_outflow, fx_inflow, fx_side_friction, &
-       fx_exchange, fx_migration, fx_nonlocal
+       fx_exchange, fx_migration, fx_nonlocal, fx_dilation
   use output_effects, only: effects_t
   use mpm_grid, only: grid_init
   use mpm_particles, only: particle_block_size
@@ -183,18 +183,20 @@ contains
     type(model_t), intent(in) :: m
     integer, intent(in) :: nranks
     type(effects_t), intent(inout) :: fx
-    logical :: inflow, damping, gravity, side
+    logical :: inflow, damping, gravity, side, dilation
     integer :: s
 
     inflow = .false.
     damping = .false.
     gravity = .false.
     side = .false.
+    dilation = .false.
     do s = 1, m%n_steps
        inflow = inflow .or. m%mpm%steps(s)%inflow%on
        damping = damping .or. m%mpm%steps(s)%damping > 0
        if (allocated(m%steps(s)%gravity)) gravity = gravity .or. size(m%steps(s)%gravity) > 0
        side = side .or. m%mpm%steps(s)%side_friction > 0
+       dilation = dilation .or. m%mpm%steps(s)%max_dilation > 0
     end do
     call fx%declare(fx_p2g, 'p2g', active=.true.)
     call fx%declare(fx_grid, 'grid update', active=.true.)
@@ -211,6 +213,7 @@ contains
     call fx%declare(fx_exchange, 'grid exchange', active=nranks > 1)
     call fx%declare(fx_migration, 'migration', active=nranks > 1 .and. m%mpm%decomposition == decomposition_spatial)
     call fx%declare(fx_nonlocal, 'nonlocal', active=m%mpm%nonlocal%on)
+    call fx%declare(fx_dilation, 'max dilation', active=dilation, timed=.false.)
   end subroutine setup_effects
 
   !> The nodes the active walls of the step constrain: local damping leaves them alone, so that

@@ -26,7 +26,7 @@ module mpm_state
        fx_kinematics = fx_p2g + 3, fx_material = fx_p2g + 4, fx_user_field = fx_p2g + 5, fx_gravity = fx_p2g + 6, &
        fx_damping = fx_p2g + 7, fx_walls = fx_p2g + 8, fx_outflow = fx_p2g + 9, fx_inflow = fx_p2g + 10, &
        fx_side_friction = fx_p2g + 11, fx_exchange = fx_p2g + 12, fx_migration = fx_p2g + 13, &
-       fx_nonlocal = fx_p2g + 14
+       fx_nonlocal = fx_p2g + 14, fx_dilation = fx_p2g + 15
 
   !> Work sets for partial blocks a rank keeps (mpm_state_t%work): more than the partial blocks
   !> a rank usually holds at once (1-8 in the ch. 4 discharge); a work set is at most
@@ -71,6 +71,9 @@ module mpm_state
      ! mass bookkeeping (exact: particle masses never change)
      real(dp) :: mass_initial = 0, mass_in = 0, mass_out = 0   !< mass_out: rank
      integer :: n_initial = 0, n_in = 0, n_out = 0, n_guarded = 0  !< n_out, n_guarded: rank
+     !> particle-increments whose J was held at MAX DILATION since this run (or its restart)
+     !> began (rank; not checkpointed: a count for the summary, not state)
+     integer(int64) :: n_dilation_held = 0
      real(dp) :: mass_cutoff = 0
      ! energies (global sums; 2D per unit thickness)
      real(dp) :: e_kinetic = 0, e_internal = 0, w_external = 0, e_walls = 0, e_damping = 0

@@ -2,16 +2,18 @@
 !> F ← (I + LΔt) F, the Green–Naghdi frame R of F (fem_corotation, the elements' code), the
 !> corotational strain increment and relative spin, the density at mid-increment, and the
 !> material call through the element blocks' VUMAT door (VUSDFLD + VUMAT); σ back to the
-!> global frame, LE accumulated. Owns the VUMAT work sets of the particle blocks.
+!> global frame, LE accumulated; *MPM CONTROLS, MAX DILATION holds J = det F at most j
+!> (hold_dilation). Owns the VUMAT work sets of the particle blocks.
 !>
 !> Why Green–Naghdi and not Jaumann/Hughes–Winget: the VUMAT contract (and our elements) hand
 !> the material stresses in the frame R of F = RU; a particle carries F, so the same frame, the
 !> same relSpinInc and the same code serve both (a user VUMAT sees one convention).
 module mpm_stress_update
+  use, intrinsic :: iso_fortran_env, only: int64
   use base_kinds, only: dp
   use error_report, only: raise_error
   use model, only: model_t
-  use mpm_state, only: mpm_state_t, fx_kinematics, fx_material
+  use mpm_state, only: mpm_state_t, fx_kinematics, fx_material, fx_dilation
   use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_transfer, only: gather_gradient, gather_gradient_3d_packed
   use model_particle_fields, only: particle_temperature
@@ -94,6 +96,10 @@ contains
     b%log_strain = b%log_strain + strain_corot
     b%f = f_new
     b%rot = r_new
+    if (fx%active(fx_dilation)) then
+       if (m%mpm%steps(st%step)%max_dilation > 0) call hold_dilation(nb, nd, m%mpm%steps(st%step)%max_dilation, &
+            b%f, st%n_dilation_held)
+    end if
     call to_global(nb, nd, st%nc, r_new, b%stress, b%stress_global)
     call fx%stop(fx_kinematics)
   end subroutine stress_update
@@ -193,6 +199,36 @@ contains
        spin(:, 3) = 0.5_dp * dt * (l(:, 2, 1) - l(:, 1, 2))
     end if
   end subroutine block_kinematics
+
+  !> *MPM CONTROLS, MAX DILATION=jmax: every particle of the block with J = det F > jmax gets
+  !> F ← (jmax/J)^(1/nd) F, so J = jmax (2D: the in-plane F; F33 = 1 in plane strain). R of F = RU
+  !> does not change; the stress is the material's. Why: a granular particle cannot be looser than
+  !> its loosest packing — beyond it the grains separate, which one particle cannot show — and
+  !> its volume J V0 sets its wave speed √(M J/ρ0), hence the stable increment of the whole run
+  !> (a particle hanging at an outlet's edge stretched to J ≈ 21 made it 4.6 times shorter:
+  !> docs/bins.md). `held` counts the particles so treated.
+  pure subroutine hold_dilation(nb, nd, jmax, f, held)
+    integer, intent(in) :: nb, nd
+    real(dp), intent(in) :: jmax
+    real(dp), intent(inout) :: f(nb, nd, nd)
+    integer(int64), intent(inout) :: held
+    real(dp) :: detf
+    integer :: p
+
+    do p = 1, nb
+       if (nd == 2) then
+          detf = f(p, 1, 1) * f(p, 2, 2) - f(p, 1, 2) * f(p, 2, 1)
+       else
+          detf = f(p, 1, 1) * (f(p, 2, 2) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 2)) &
+               - f(p, 1, 2) * (f(p, 2, 1) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 1)) &
+               + f(p, 1, 3) * (f(p, 2, 1) * f(p, 3, 2) - f(p, 2, 2) * f(p, 3, 1))
+       end if
+       if (detf > jmax) then
+          f(p, :, :) = (jmax / detf)**(1.0_dp / nd) * f(p, :, :)
+          held = held + 1
+       end if
+    end do
+  end subroutine hold_dilation
 
   !> A VUMAT work set of `rows` rows; U = F = I, which stay for the materials that do not read
   !> them (needs_kinematics false: stress_update does not write them).
