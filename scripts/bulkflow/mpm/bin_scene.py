@@ -121,7 +121,7 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
               psi_max=PSI_MAX, wall_friction=PHI_WALL, right_wall_friction=None, floor_friction=None,
               fill_time=0.3, ramp=0.2, discharge_time=8.0, fill_damping=0.1, flip=0.99, cfl=0.3,
               shape="GIMP", field_dt=0.1, history_dt=0.01, outflow_cells=2.0, side_friction=None,
-              title=""):
+              max_dilation=0.0, title=""):
     """The scene text (Abaqus keyword syntax). Angles in degrees; see the module text."""
     if sand not in SANDS:
         raise ValueError(f"sand must be one of {SANDS}")
@@ -148,7 +148,9 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     # corners in full, so that the node lines fall on x = 0 and y = 0 to round-off
     w(f"{lo[0]:.15g}, {lo[1]:.15g}")
     w(f"{hi[0]:.15g}, {hi[1]:.15g}")
-    w(f"*MPM CONTROLS, FLIP={flip:g}, CFL={cfl:g}, DAMPING={fill_damping:g}")
+    # MAX DILATION only when asked: the scene text (and the study's run cache) of before otherwise
+    held = f", MAX DILATION={max_dilation:g}" if max_dilation > 0 else ""
+    w(f"*MPM CONTROLS, FLIP={flip:g}, CFL={cfl:g}, DAMPING={fill_damping:g}{held}")
     if side_friction is not None:
         # front and back glass walls of the quasi-2D bin (issue 20 point 2, docs/keywords.md)
         w(f"*MPM SIDE FRICTION, GAP={side_friction:.9g}, FRICTION={mu:.7f}")
@@ -229,6 +231,8 @@ def main(argv=None):
     p.add_argument("--history-dt", type=float, default=0.01)
     p.add_argument("--side-friction", type=float, metavar="GAP",
                    help="front/back wall gap [m]: writes *MPM SIDE FRICTION (solver with issue 20 point 2)")
+    p.add_argument("--max-dilation", type=float, default=0.0, metavar="J",
+                   help="*MPM CONTROLS, MAX DILATION=J: particles' V/V0 held at most J (0: off; docs/bins.md)")
     a = p.parse_args(argv)
     try:
         text = bin_scene(case=a.case, sand=a.sand, cell=a.cell, edge_cells=a.edge_cells, ppc=a.ppc,
@@ -237,7 +241,8 @@ def main(argv=None):
                          wall_friction=a.wall_friction, right_wall_friction=a.right_wall_friction,
                          floor_friction=a.floor_friction, fill_time=a.fill_time, ramp=a.ramp,
                          discharge_time=a.discharge_time, shape=a.shape, flip=a.flip, cfl=a.cfl,
-                         field_dt=a.field_dt, history_dt=a.history_dt, side_friction=a.side_friction)
+                         field_dt=a.field_dt, history_dt=a.history_dt, side_friction=a.side_friction,
+                         max_dilation=a.max_dilation)
     except ValueError as e:
         p.error(str(e))
     with open(a.output, "w") as f:
