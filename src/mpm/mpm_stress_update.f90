@@ -13,7 +13,7 @@ module mpm_stress_update
   use base_kinds, only: dp
   use error_report, only: raise_error
   use model, only: model_t
-  use mpm_state, only: mpm_state_t, fx_kinematics, fx_material, fx_dilation
+  use mpm_state, only: mpm_state_t, fx_kinematics, fx_material, fx_dilation, det_f
   use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_transfer, only: gather_gradient, gather_gradient_3d_packed
   use model_particle_fields, only: particle_temperature
@@ -216,13 +216,7 @@ contains
     integer :: p
 
     do p = 1, nb
-       if (nd == 2) then
-          detf = f(p, 1, 1) * f(p, 2, 2) - f(p, 1, 2) * f(p, 2, 1)
-       else
-          detf = f(p, 1, 1) * (f(p, 2, 2) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 2)) &
-               - f(p, 1, 2) * (f(p, 2, 1) * f(p, 3, 3) - f(p, 2, 3) * f(p, 3, 1)) &
-               + f(p, 1, 3) * (f(p, 2, 1) * f(p, 3, 2) - f(p, 2, 2) * f(p, 3, 1))
-       end if
+       detf = det_f(f, p, nd)
        if (detf > jmax) then
           f(p, :, :) = (jmax / detf)**(1.0_dp / nd) * f(p, :, :)
           held = held + 1
