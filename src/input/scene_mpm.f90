@@ -34,6 +34,7 @@ module scene_mpm
   use scene_materials, only: find_material
   use scene_mpm_side, only: read_side_friction
   use scene_mpm_decomposition, only: read_decomposition
+  use scene_mpm_controls, only: read_mpm_controls
   use scene_mpm_nonlocal, only: read_nonlocal
   use scene_util, only: itoa, rtoa, get_real, expect_lines, expect_fields, last_field, where_text, &
        check_name
@@ -141,7 +142,7 @@ contains
          associate (blk => deck%blocks(i))
            select case (blk%name)
            case ('MPM CONTROLS')
-              call read_controls(blk, carry, err)
+              call read_mpm_controls(blk, carry, err)
               if (.not. err%raised) call read_decomposition(blk, mpm, err)
            case ('MPM SIDE FRICTION')
               call read_side_friction(blk, mpm%ndim, carry, err)
@@ -173,7 +174,7 @@ contains
             associate (blk => deck%blocks(i))
               select case (blk%name)
               case ('MPM CONTROLS')
-                 call read_controls(blk, carry, err)
+                 call read_mpm_controls(blk, carry, err)
                  if (.not. err%raised .and. (blk%has_param('DECOMPOSITION') .or. blk%has_param('REBALANCE'))) &
                       call blk%fail('DECOMPOSITION/REBALANCE in a step; expected them in the model data', err)
               case ('MPM SIDE FRICTION')
@@ -306,33 +307,6 @@ contains
     end do
     close (unit)
   end function physical_memory
-
-  subroutine read_controls(blk, c, err)
-    type(keyword_block_t), intent(in) :: blk
-    type(mpm_step_t), intent(inout) :: c
-    type(error_t), intent(inout) :: err
-    real(dp) :: flip, cfl, damping, max_dilation
-    integer :: sort
-
-    call blk%check_params([character(len=13) :: 'FLIP', 'CFL', 'DAMPING', 'SORT', 'DECOMPOSITION', 'REBALANCE', &
-         'MAX DILATION'], err)
-    if (.not. err%raised) call blk%get_real('FLIP', flip, err, default=c%flip, minimum=0.0_dp, maximum=1.0_dp)
-    if (.not. err%raised) call blk%get_real('CFL', cfl, err, default=c%cfl, minimum=1.0e-3_dp, maximum=1.0_dp)
-    if (.not. err%raised) call blk%get_real('DAMPING', damping, err, default=c%damping, minimum=0.0_dp, &
-         maximum=0.99_dp)
-    if (.not. err%raised) call blk%get_integer('SORT', sort, err, default=c%sort, minimum=0)
-    if (.not. err%raised) call blk%get_real('MAX DILATION', max_dilation, err, default=c%max_dilation, &
-         minimum=0.0_dp)
-    if (.not. err%raised .and. max_dilation > 0 .and. max_dilation < 1) call blk%fail('*MPM CONTROLS: MAX DILATION=' // &
-         rtoa(max_dilation) // '; expected 0 (off) or a volume ratio V/V0 >= 1', err)
-    if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
-    if (err%raised) return
-    c%flip = flip
-    c%cfl = cfl
-    c%damping = damping
-    c%sort = sort
-    c%max_dilation = max_dilation
-  end subroutine read_controls
 
   subroutine material_param(blk, model, k, err)
     type(keyword_block_t), intent(in) :: blk
