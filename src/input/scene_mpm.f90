@@ -1,7 +1,7 @@
 !> The material-point keywords of a scene (bulkflow's own; docs/keywords.md, section "MPM"):
 !>
 !>   *MPM GRID, CELL=h [, SHAPE=GIMP|LINEAR]        data: lo corner; hi corner (2 or 3 values)
-!>   *MPM CONTROLS [, FLIP=α] [, CFL=c] [, DAMPING=a] [, SORT=n] [, MAX DILATION=j]
+!>   *MPM CONTROLS [, FLIP=α | PIC TIME=τ] [, CFL=c] [, DAMPING=a] [, SORT=n] [, MAX DILATION=j]
 !>                                                  model data or in a step; carries over
 !>     [, DECOMPOSITION=REPLICATED|SPATIAL] [, REBALANCE=r]   model data only (MPI ranks)
 !>   *MPM SIDE FRICTION, GAP=t, FRICTION=μw         2D, model data or in a step; carries over

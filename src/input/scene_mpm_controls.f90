@@ -1,5 +1,5 @@
-!> The reader of a step's `*MPM CONTROLS` (docs/keywords.md, "Material point method"): FLIP, CFL,
-!> DAMPING, SORT and MAX DILATION of a step, each carried over from the step before unless given
+!> The reader of a step's `*MPM CONTROLS` (docs/keywords.md, "Material point method"): FLIP or
+!> PIC TIME, CFL, DAMPING, SORT and MAX DILATION of a step, each carried over from the step before unless given
 !> (DECOMPOSITION and REBALANCE, model data only, are scene_mpm_decomposition's). Apart from
 !> scene_mpm to keep that reader within its size.
 module scene_mpm_controls
@@ -20,12 +20,15 @@ contains
     type(keyword_block_t), intent(in) :: blk
     type(mpm_step_t), intent(inout) :: c
     type(error_t), intent(inout) :: err
-    real(dp) :: flip, cfl, damping, max_dilation
+    real(dp) :: flip, pic_time, cfl, damping, max_dilation
     integer :: sort
 
     call blk%check_params([character(len=13) :: 'FLIP', 'CFL', 'DAMPING', 'SORT', 'DECOMPOSITION', 'REBALANCE', &
-         'MAX DILATION'], err)
+         'MAX DILATION', 'PIC TIME'], err)
+    if (.not. err%raised .and. blk%has_param('FLIP') .and. blk%has_param('PIC TIME')) call blk%fail( &
+         '*MPM CONTROLS: FLIP and PIC TIME together; expected one of them (the blend per increment, or as a rate)', err)
     if (.not. err%raised) call blk%get_real('FLIP', flip, err, default=c%flip, minimum=0.0_dp, maximum=1.0_dp)
+    if (.not. err%raised) call blk%get_real('PIC TIME', pic_time, err, default=c%pic_time, minimum=0.0_dp)
     if (.not. err%raised) call blk%get_real('CFL', cfl, err, default=c%cfl, minimum=1.0e-3_dp, maximum=1.0_dp)
     if (.not. err%raised) call blk%get_real('DAMPING', damping, err, default=c%damping, minimum=0.0_dp, &
          maximum=0.99_dp)
@@ -39,6 +42,9 @@ contains
     if (.not. err%raised) call expect_lines(blk, 0, 0, 'no data lines', err)
     if (err%raised) return
     c%flip = flip
+    c%pic_time = pic_time
+    ! a FLIP given later replaces an earlier step's PIC TIME (and PIC TIME a FLIP): one rule at a time
+    if (blk%has_param('FLIP')) c%pic_time = 0
     c%cfl = cfl
     c%damping = damping
     c%sort = sort

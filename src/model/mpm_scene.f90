@@ -63,7 +63,10 @@ module mpm_scene
 
   !> MPM controls of one step (*MPM CONTROLS carries over to later steps until repeated).
   type, public :: mpm_step_t
-     real(dp) :: flip = 0.99_dp             !< PIC/FLIP blend α (1: FLIP, 0: PIC)
+     real(dp) :: flip = 0.99_dp             !< PIC/FLIP blend α (1: FLIP, 0: PIC) of every increment
+     !> *MPM CONTROLS, PIC TIME=τ: the blend as a rate, α = exp(-Δt/τ) in an increment Δt, so the
+     !> PIC part's damping per second does not depend on Δt (0: off, the fixed α above)
+     real(dp) :: pic_time = 0
      real(dp) :: cfl = 0.3_dp               !< Δt = cfl h / max(c + |v|)
      real(dp) :: damping = 0                !< local non-viscous damping coefficient on the grid
      !> particles sorted by cell every `sort` increments, P2G and remap particle by particle

@@ -9,6 +9,7 @@ module mpm_musl
   use base_kinds, only: dp
   use error_report, only: raise_error
   use model, only: model_t
+  use mpm_scene, only: mpm_step_t
   use model_time_variation, only: variation_factor
   use model_steps, only: bc_velocity
   use mpm_state, only: mpm_state_t, fx_p2g, fx_grid, fx_g2p, fx_walls, fx_exchange, max_over_ranks, det_f
@@ -32,7 +33,7 @@ module mpm_musl
   private
 
   public :: stable_increment, block_max_speed, step_gravity, musl_transfer
-  public :: stencil, p2g, grid_update, g2p, remap_velocity, rigid_surface_motion
+  public :: stencil, p2g, grid_update, g2p, remap_velocity, rigid_surface_motion, flip_weight
 
 contains
 
@@ -260,8 +261,10 @@ contains
     logical, intent(in) :: packed, sorted
     integer, intent(in) :: ilo, ihi
     integer :: ib, s
+    real(dp) :: alpha
 
     s = st%step
+    alpha = flip_weight(m%mpm%steps(s), st%dt)
     if (packed) then
        ! every block's gather and particle update (v_new, v_old packed), then every block's remap
        ! into the records' first 4 nn values: each node's sum in the particle order of the
@@ -271,9 +274,9 @@ contains
           associate (b => st%blocks(ib))
             if (sorted) then
                call gather_velocity_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
-                    b%w1, st%gpack, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, st%w_external)
+                    b%w1, st%gpack, b%mass, st%gravity, alpha, st%dt, b%v, b%x, st%w_external)
             else
-               call g2p_packed(st, b, m%mpm%steps(s)%flip)
+               call g2p_packed(st, b, alpha)
             end if
           end associate
        end do
@@ -295,11 +298,11 @@ contains
           if (sorted) then
              associate (b => st%blocks(ib))
                call g2p_particles(b%count, st%nsup, st%nd, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, &
-                    b%w1, st%g%v_new, st%g%v_old, b%mass, st%gravity, m%mpm%steps(s)%flip, st%dt, b%v, b%x, &
+                    b%w1, st%g%v_new, st%g%v_old, b%mass, st%gravity, alpha, st%dt, b%v, b%x, &
                     st%g%mom, st%w_external)
              end associate
           else
-             call g2p(st, st%blocks(ib), m%mpm%steps(s)%flip)
+             call g2p(st, st%blocks(ib), alpha)
           end if
        end do
     end if
@@ -580,6 +583,22 @@ contains
     call scatter_momentum_3d_packed(b%count, st%g%nn, st%g%n(1), st%g%n(1) * st%g%n(2), b%corner, b%w1, b%mass, &
          b%v, mv4, st%gpack)
   end subroutine remap_packed
+
+  !> The FLIP weight α of an increment dt under the step's controls. A fixed α removes the share
+  !> 1 − α of the particles' sub-grid velocity (v_p − v_PIC) every increment: a damping rate
+  !> (1 − α)/dt that grows as the increment shrinks (a stiffer material, a smaller CFL or cell
+  !> damps the flow more: docs/theory/mpm.md §4.3). With PIC TIME=τ the sub-grid part decays
+  !> as exp(−t/τ) whatever the increments: α = exp(−dt/τ).
+  pure real(dp) function flip_weight(c, dt) result(alpha)
+    type(mpm_step_t), intent(in) :: c
+    real(dp), intent(in) :: dt
+
+    if (c%pic_time > 0) then
+       alpha = exp(-dt / c%pic_time)
+    else
+       alpha = c%flip
+    end if
+  end function flip_weight
 
   !> g2p's particle update: PIC/FLIP velocity, position, the gravity's work wk; dv returns the
   !> particles' momentum m v for the remap.

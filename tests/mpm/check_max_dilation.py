@@ -8,52 +8,27 @@
 - with it, no particle of any frame is looser than 1440 kg/m3 (to 1e-9 relative), the summary
   counts the particle-increments held, and the run takes fewer increments (the stretched
   particle no longer sets the stable increment);
-- both runs keep the particle and mass balance exact (n0 = out + remaining; |M0 - MASS_OUT - MASS|
-  round-off), so holding J moves no mass.
+- both runs keep the particle and mass balance exact (bin_checks.balance: n0 = out + remaining,
+  MASS_OUT = n_out particle masses, |M0 - MASS_OUT - MASS| round-off), so holding J moves no mass.
 
     check_max_dilation.py <bin.inp> --bulkflow <exe> --workdir <dir>
 """
 import argparse
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import h5py
-import numpy as np
 
-FAILED = []
+from bin_checks import Checks, balance, run_scene, with_controls
+
 JMAX = 1.25
 
 
-def check(ok, what):
-    print(("ok    " if ok else "FAIL  ") + what)
-    if not ok:
-        FAILED.append(what)
-
-
 def run(exe, scene, base):
-    r = subprocess.run([exe, str(scene), "--output", str(base)], capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.stdout.write(r.stdout)
-        sys.stderr.write(r.stderr)
-        sys.exit(f"bulkflow failed on {scene} (status {r.returncode})")
-    hist = np.genfromtxt(str(base) + "_history.csv", delimiter=",", names=True)
+    out, hist = run_scene(exe, scene, base)
     with h5py.File(str(base) + ".h5", "r") as f:
         rho_min = min(float(f["particles"][k]["density"][:].min()) for k in f["particles"])
-    return r.stdout, hist, rho_min
-
-
-def balance(name, out, hist):
-    m = re.search(r"particles (\d+) \((\d+) in, (\d+) out\)", out)
-    check(m is not None, f"{name}: summary line with particle counts")
-    if m is None:
-        return
-    nend, _, nout = (int(v) for v in m.groups())
-    n0 = int(hist["particles"][0])
-    check(n0 == nout + nend and nout > 0, f"{name}: particles {n0} initial = {nout} out + {nend} remaining")
-    err = np.abs(hist["MASS_ERROR"]).max()
-    check(err <= 1e-12 * hist["MASS"][0], f"{name}: max |M0 - MASS_OUT - MASS| = {err:.3e} kg")
+    return out, hist, rho_min
 
 
 def main():
@@ -65,11 +40,9 @@ def main():
     work = Path(a.workdir)
     work.mkdir(parents=True, exist_ok=True)
     text = Path(a.scene).read_text()
-    controls = re.search(r"^\*MPM CONTROLS[^\n]*$", text, re.M)
-    if controls is None:
-        sys.exit(f"{a.scene}: no *MPM CONTROLS line to add MAX DILATION to")
+    check = Checks()
     held_scene = work / "bin_max_dilation.inp"
-    held_scene.write_text(text[:controls.end()] + f", MAX DILATION={JMAX}" + text[controls.end():])
+    held_scene.write_text(with_controls(text, a.scene, lambda line: line + f", MAX DILATION={JMAX}"))
     rho_i = float(re.search(r"^\*DENSITY\s*\n\s*([0-9.eE+-]+)", text, re.M).group(1))
     floor = rho_i / JMAX
 
@@ -83,11 +56,9 @@ def main():
     check("held at MAX DILATION" not in out0, "no such line when the scene does not ask for it")
     inc0, inc1 = int(hist0["increment"][-1]), int(hist1["increment"][-1])
     check(inc1 < inc0, f"the held run takes fewer increments: {inc1} < {inc0}")
-    balance("free", out0, hist0)
-    balance("held", out1, hist1)
-    if FAILED:
-        sys.exit(f"{len(FAILED)} check(s) failed")
-    print("all checks passed")
+    balance(check, "free", out0, hist0)
+    balance(check, "held", out1, hist1)
+    check.finish()
 
 
 if __name__ == "__main__":

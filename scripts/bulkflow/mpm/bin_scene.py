@@ -121,7 +121,7 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
               psi_max=PSI_MAX, wall_friction=PHI_WALL, right_wall_friction=None, floor_friction=None,
               fill_time=0.3, ramp=0.2, discharge_time=8.0, fill_damping=0.1, flip=0.99, cfl=0.3,
               shape="GIMP", field_dt=0.1, history_dt=0.01, outflow_cells=2.0, side_friction=None,
-              max_dilation=0.0, title=""):
+              max_dilation=0.0, pic_time=0.0, title=""):
     """The scene text (Abaqus keyword syntax). Angles in degrees; see the module text."""
     if sand not in SANDS:
         raise ValueError(f"sand must be one of {SANDS}")
@@ -150,7 +150,9 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     w(f"{hi[0]:.15g}, {hi[1]:.15g}")
     # MAX DILATION only when asked: the scene text (and the study's run cache) of before otherwise
     held = f", MAX DILATION={max_dilation:g}" if max_dilation > 0 else ""
-    w(f"*MPM CONTROLS, FLIP={flip:g}, CFL={cfl:g}, DAMPING={fill_damping:g}{held}")
+    # PIC TIME (the blend as a rate, docs/theory/mpm.md 4.3) in place of FLIP only when asked
+    blend = f"PIC TIME={pic_time:g}" if pic_time > 0 else f"FLIP={flip:g}"
+    w(f"*MPM CONTROLS, {blend}, CFL={cfl:g}, DAMPING={fill_damping:g}{held}")
     if side_friction is not None:
         # front and back glass walls of the quasi-2D bin (issue 20 point 2, docs/keywords.md)
         w(f"*MPM SIDE FRICTION, GAP={side_friction:.9g}, FRICTION={mu:.7f}")
@@ -233,7 +235,12 @@ def main(argv=None):
                    help="front/back wall gap [m]: writes *MPM SIDE FRICTION (solver with issue 20 point 2)")
     p.add_argument("--max-dilation", type=float, default=0.0, metavar="J",
                    help="*MPM CONTROLS, MAX DILATION=J: particles' V/V0 held at most J (0: off; docs/bins.md)")
+    p.add_argument("--pic-time", type=float, default=0.0, metavar="TAU",
+                   help="*MPM CONTROLS, PIC TIME=TAU [s] in place of --flip: the PIC/FLIP blend as a rate, "
+                        "independent of the increment (0: off; docs/bins.md)")
     a = p.parse_args(argv)
+    if a.pic_time < 0:
+        p.error("--pic-time must be >= 0")
     try:
         text = bin_scene(case=a.case, sand=a.sand, cell=a.cell, edge_cells=a.edge_cells, ppc=a.ppc,
                          outlet=a.outlet, width=a.width, fill=a.fill, density=a.density, rho_cv=a.rho_cv,
@@ -242,7 +249,7 @@ def main(argv=None):
                          floor_friction=a.floor_friction, fill_time=a.fill_time, ramp=a.ramp,
                          discharge_time=a.discharge_time, shape=a.shape, flip=a.flip, cfl=a.cfl,
                          field_dt=a.field_dt, history_dt=a.history_dt, side_friction=a.side_friction,
-                         max_dilation=a.max_dilation)
+                         max_dilation=a.max_dilation, pic_time=a.pic_time)
     except ValueError as e:
         p.error(str(e))
     with open(a.output, "w") as f:

@@ -43,6 +43,9 @@ def add_arguments(p):
                    help="Young's modulus [Pa] (Table 5.3: 8 MPa; lower: larger stable increment)")
     p.add_argument("--max-dilation", type=float, default=0.0, metavar="J",
                    help="*MPM CONTROLS, MAX DILATION=J in every run (0: off; docs/bins.md)")
+    p.add_argument("--pic-time", type=float, default=0.0, metavar="TAU",
+                   help="*MPM CONTROLS, PIC TIME=TAU [s] in every run: the PIC/FLIP blend as a rate, "
+                        "the discharge independent of E and the increment (0: FLIP=0.99; docs/bins.md)")
     p.add_argument("--variants", action="store_true", help="also the 34 deg right wall and rho_i = 1600 runs")
     p.add_argument("--cases", nargs="+",
                    help="only these, e.g. concentric:NDNS eccentric:DS:4 (a third field: its own discharge time [s])")
@@ -73,7 +76,8 @@ def _runs(a):
     rows = []
     for case, sand, kw, lab in todo:
         scene = dict(case=case, sand=sand, edge_cells=a.edge_cells, ppc=a.ppc, discharge_time=a.discharge,
-                     fill_time=a.fill_time, young=a.young, max_dilation=a.max_dilation)
+                     fill_time=a.fill_time, young=a.young, max_dilation=a.max_dilation,
+                     pic_time=a.pic_time)
         scene.update(kw)
         r = run_bin(a.bulkflow, a.runs, reuse=not a.no_reuse, **scene)
         r["label"] = f"{case} {sand}" + (f", {lab}" if lab else "")
@@ -129,7 +133,8 @@ def _velocities(r, frames, heights, avg_from):
 def run(a):
     print(f"flat-bottomed bins (thesis ch. 5): outlet {OUTLET * 1e3:g} mm, cell outlet/{2 * a.edge_cells + 1}, "
           f"PPC {a.ppc}, E {a.young / 1e6:g} MPa, fill {a.fill_time:g} s + discharge {a.discharge:g} s (or the case's own)"
-          + (f", MAX DILATION {a.max_dilation:g}" if a.max_dilation > 0 else ""), flush=True)
+          + (f", MAX DILATION {a.max_dilation:g}" if a.max_dilation > 0 else "")
+          + (f", PIC TIME {a.pic_time:g} s" if a.pic_time > 0 else ""), flush=True)
     rows = _runs(a)
     bev = {C: beverloo_per_metre(RHO_I, C) for C in (0.64, 0.58)}
     table = []
