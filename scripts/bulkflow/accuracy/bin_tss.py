@@ -55,6 +55,8 @@ EDGE_CELLS = [1, 2, 3, 4]
 QUICK_EDGE_CELLS = [1, 2, 3]
 FULL = dict(width=0.20, fill=0.60, young=8.0e6, discharge_time=5.0)
 QUICK = dict(width=0.15, fill=0.50, young=1.0e6, discharge_time=3.0)
+# bulkflow-accuracy --pic-time: *MPM CONTROLS, PIC TIME in every member (0: the scene's FLIP=0.99)
+PIC_TIME = 0.0
 STATUS_REACHED, STATUS_NOT_REACHED, STATUS_NO_STEADY = "reached", "not reached", "no steady regime"
 
 
@@ -74,7 +76,7 @@ def scene(member: dict) -> str:
     # one particle frame per second is enough: the measure reads the history (MASS_OUT every 0.01 s)
     return bin_scene(case="eccentric", sand="NDNS", edge_cells=member["edge_cells"], ppc=2, outlet=OUTLET,
                      width=kw["width"], fill=kw["fill"], young=kw["young"], fill_time=0.3, ramp=0.2,
-                     discharge_time=kw["discharge_time"], field_dt=1.0, history_dt=0.01)
+                     discharge_time=kw["discharge_time"], field_dt=1.0, history_dt=0.01, pic_time=PIC_TIME)
 
 
 def classify(t, mass, t_open, interval: float = T_SS_INTERVAL) -> dict:

@@ -24,6 +24,9 @@ def main(argv=None) -> int:
     parser.add_argument("--solver", default=None, help="bulkflow binary (default BULKFLOW_BIN or build/bin/bulkflow)")
     parser.add_argument("--criterion", default=None,
                         help="arching-cow only: the flow criterion, passed to bulkflow.arching when it takes one")
+    parser.add_argument("--pic-time", type=float, default=0.0, metavar="TAU",
+                        help="hopper-mdr and bin-tss only: *MPM CONTROLS, PIC TIME=TAU [s] in every member, "
+                             "the PIC/FLIP blend as a rate (docs/accuracy.md); 0: the scenes' FLIP=0.99")
     parser.add_argument("--summarise-only", action="store_true",
                         help="no runs: the summary and outputs again from the measured rows of OUT/KIND.json")
     args = parser.parse_args(argv)
@@ -39,6 +42,12 @@ def main(argv=None) -> int:
         if arching_cow.criterion_supported() is None:
             parser.error("--criterion: this checkout's bulkflow.arching has no flow criterion option")
         arching_cow.CRITERION = args.criterion
+    if args.pic_time:
+        if args.kind not in ("hopper-mdr", "bin-tss"):
+            parser.error("--pic-time applies to hopper-mdr and bin-tss only")
+        if args.pic_time < 0:
+            parser.error("--pic-time must be >= 0")
+        (hopper_mdr if args.kind == "hopper-mdr" else bin_tss).PIC_TIME = args.pic_time
     out = args.out or Path("out") / "accuracy" / args.kind
     print(f"{kind['name']}: {kind['title']}{' (quick)' if args.quick else ''}")
     if args.summarise_only:

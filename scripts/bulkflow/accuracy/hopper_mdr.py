@@ -27,6 +27,8 @@ EDGE_CELLS = [1.5, 2.5, 3.5, 4.5, 5.5]
 QUICK_EDGE_CELLS = [1.5, 2.5, 3.5, 4.5, 5.5]
 FULL = dict(height=3.0, fill_time=1.0, discharge_time=1.5)
 QUICK = dict(height=1.0, fill_time=0.5, ramp=0.3, discharge_time=1.0)
+# bulkflow-accuracy --pic-time: *MPM CONTROLS, PIC TIME in every member (0: the scene's FLIP=0.99)
+PIC_TIME = 0.0
 
 
 def members(quick: bool) -> list[dict]:
@@ -40,6 +42,8 @@ def members(quick: bool) -> list[dict]:
 
 def scene(member: dict) -> str:
     kw = dict(QUICK if member["quick_case"] else FULL)
+    if PIC_TIME > 0:
+        kw["pic_time"] = PIC_TIME
     # 2 particle frames in the fill step, 6 in the discharge: the wall force averages the last 3
     return scene_text(cell=member["cell"], ppc=2, shape="GIMP", field_frames=2, discharge_frames=6, **kw)
 

@@ -137,7 +137,7 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
                  flip=0.99, cfl=0.3, shape="GIMP", field_frames=10, history_dt=0.01,
                  dilation=True, title="", phi=20.0, psi_initial=15.0, eps_cv=0.2,
                  psi_constant=None, young=1.0e7, poisson=0.2, density=1600.0, model="MC",
-                 wall_reach=None, outflow_cells=2.0, discharge_frames=None, command=None):
+                 wall_reach=None, outflow_cells=2.0, discharge_frames=None, command=None, pic_time=0.0):
     """The scene text. `discharge_frames`: field frames of the discharge step (default
     `field_frames`, the number of the fill step); `command`: the command line that wrote the
     file, put in its header (main() passes its own)."""
@@ -168,7 +168,9 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w(f"*MPM GRID, CELL={cell:.12g}, SHAPE={shape}")
     w(f"{lo[0]:.9f}, {lo[1]:.9f}")
     w(f"{hi[0]:.9f}, {hi[1]:.9f}")
-    w(f"*MPM CONTROLS, FLIP={flip:g}, CFL={cfl:g}, DAMPING={fill_damping:g}")
+    # PIC TIME (the blend as a rate, docs/theory/mpm.md 4.3) in place of FLIP only when asked
+    blend = f"PIC TIME={pic_time:g}" if pic_time > 0 else f"FLIP={flip:g}"
+    w(f"*MPM CONTROLS, {blend}, CFL={cfl:g}, DAMPING={fill_damping:g}")
     name = "DP-FILL" if model == "DP" else "MC-FILL"
     lines += material_lines(name, model=model, density=density, young=young, poisson=poisson, phi=phi,
                             psi_initial=psi_initial, eps_cv=eps_cv, psi_constant=psi_constant,
