@@ -43,9 +43,10 @@ def add_arguments(p):
                    help="Young's modulus [Pa] (Table 5.3: 8 MPa; lower: larger stable increment)")
     p.add_argument("--max-dilation", type=float, default=0.0, metavar="J",
                    help="*MPM CONTROLS, MAX DILATION=J in every run (0: off; docs/bins.md)")
-    p.add_argument("--pic-time", type=float, default=0.0, metavar="TAU",
+    p.add_argument("--pic-time", type=float, default=0.01, metavar="TAU",
                    help="*MPM CONTROLS, PIC TIME=TAU [s] in every run: the PIC/FLIP blend as a rate, "
-                        "the discharge independent of E and the increment (0: FLIP=0.99; docs/bins.md)")
+                        "the discharge independent of E and the increment (0: the fixed FLIP=0.99 of the "
+                        "runs before 2026-12-06; docs/bins.md)")
     p.add_argument("--variants", action="store_true", help="also the 34 deg right wall and rho_i = 1600 runs")
     p.add_argument("--cases", nargs="+",
                    help="only these, e.g. concentric:NDNS eccentric:DS:4 (a third field: its own discharge time [s])")
