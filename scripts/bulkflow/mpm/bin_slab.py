@@ -43,7 +43,7 @@ def _f(v: float) -> str:
 def slab_scene(case="concentric", sand="NDNS", gap_cells=4, cell=None, edge_cells=1, ppc=2, outlet=OUTLET,
                width=None, fill=None, density=RHO_I, wall_friction=PHI_WALL, fill_time=0.3, ramp=0.2,
                discharge_time=2.0, fill_damping=0.1, flip=0.99, cfl=0.3, field_dt=0.1, history_dt=0.01,
-               outflow_cells=2.0, glass_friction=None):
+               outflow_cells=2.0, glass_friction=None, young=YOUNG, pic_time=0.0, max_dilation=0.0):
     """The 3D slab scene text; gap t = gap_cells cells; the glass walls' friction angle is the bin's
     wall friction unless `glass_friction` (degrees) is given."""
     if sand not in SANDS or case not in CASES:
@@ -68,8 +68,11 @@ def slab_scene(case="concentric", sand="NDNS", gap_cells=4, cell=None, edge_cell
     w(f"*MPM GRID, CELL={h:.12g}, SHAPE=GIMP")
     w(f"{lo[0]:.15g}, {lo[1]:.15g}, {lo[2]:.15g}")
     w(f"{hi[0]:.15g}, {hi[1]:.15g}, {hi[2]:.15g}")
-    w(f"*MPM CONTROLS, FLIP={flip:g}, CFL={cfl:g}, DAMPING={fill_damping:g}")
-    _material(w, sand, density, YOUNG, POISSON, PHI_CV, PSI_MAX, eps_cv(density, RHO_CV))
+    # as bin_scene: PIC TIME and MAX DILATION written only when asked
+    blend = f"PIC TIME={pic_time:g}" if pic_time > 0 else f"FLIP={flip:g}"
+    held = f", MAX DILATION={max_dilation:g}" if max_dilation > 0 else ""
+    w(f"*MPM CONTROLS, {blend}, CFL={cfl:g}, DAMPING={fill_damping:g}{held}")
+    _material(w, sand, density, young, POISSON, PHI_CV, PSI_MAX, eps_cv(density, RHO_CV))
     x0, x1, xl, xr = g["x_out0"], g["x_out1"], g["x_left"], g["x_right"]
     w(f"*PARTICLES, MATERIAL=MC-SAND, PPC={ppc}, TYPE=POLYGON, Z1=0., Z2={_f(t)}")
     for x, y in ((xl, 0.0), (xr, 0.0), (xr, fill_h), (xl, fill_h)):
@@ -150,8 +153,14 @@ def mean_rate(t: np.ndarray, m: np.ndarray) -> float:
 
 
 def compare(a: argparse.Namespace) -> dict:
-    common = dict(case=a.case, sand=a.sand, ppc=a.ppc, outlet=SMALL["outlet"], width=SMALL["width"],
-                  fill=SMALL["fill"], cell=SMALL["cell"], discharge_time=a.discharge)
+    if a.size == "small":
+        common = dict(case=a.case, sand=a.sand, ppc=a.ppc, outlet=SMALL["outlet"], width=SMALL["width"],
+                      fill=SMALL["fill"], cell=SMALL["cell"], discharge_time=a.discharge)
+    else:   # the thesis's bin (bin_scene's defaults) at cell outlet/(2k + 1)
+        common = dict(case=a.case, sand=a.sand, ppc=a.ppc, edge_cells=a.edge_cells, discharge_time=a.discharge)
+    if a.young is not None:
+        common["young"] = a.young
+    common.update(pic_time=a.pic_time, max_dilation=a.max_dilation)
     slab, g, gap = slab_scene(gap_cells=a.gap_cells, **common)
     half = 2.0 if g["half"] else 1.0
     scenes = {   # name: (scene, its file name, mass per metre of depth of the whole bin per kg)
@@ -171,15 +180,19 @@ def compare(a: argparse.Namespace) -> dict:
         t, m = discharged_per_metre(hist, scale)
         rows[name] = dict(rate=mean_rate(t, m), wall=wall, t=t.tolist(), mass=m.tolist(),
                           base_stress=base_stress_at_rest(out / file_name, 0.3, x_range, 0.5 * g["cell"] / a.ppc))
-    print(f"small {a.case} bin ({a.sand}, outlet {SMALL['outlet'] * 1e3:g} mm, cell {SMALL['cell'] * 1e3:g} mm, "
-          f"PPC {a.ppc}), glass walls tan({PHI_WALL:g} deg), gap {gap * 1e3:.4g} mm; {a.discharge:g} s of discharge")
+    print(f"{a.size} {a.case} bin ({a.sand}, outlet {common.get('outlet', OUTLET) * 1e3:g} mm, cell {g['cell'] * 1e3:.4g} mm, "
+          f"PPC {a.ppc}, E {common.get('young', YOUNG) / 1e6:g} MPa"
+          + (f", PIC TIME {a.pic_time:g} s" if a.pic_time > 0 else "")
+          + (f", MAX DILATION {a.max_dilation:g}" if a.max_dilation > 0 else "")
+          + f"), glass walls tan({PHI_WALL:g} deg), gap {gap * 1e3:.4g} mm; {a.discharge:g} s of discharge")
     print("  scene                  base sigma_yy at rest [Pa]  vs 3D slab | MDR [kg/s/m]  vs 3D slab | "
           "discharged [kg/m]  wall [s]")
     ref, sref = rows["3D slab"]["rate"], rows["3D slab"]["base_stress"]
     for name, r in rows.items():
         print(f"  {name:22s} {r['base_stress']:14.1f} {r['base_stress'] / sref:17.4f} | {r['rate']:11.3f} "
               f"{r['rate'] / ref:11.3f} | {r['mass'][-1]:12.3f} {r['wall']:9.1f}")
-    (out / "bin_slab_compare.json").write_text(json.dumps(dict(gap=gap, case=a.case, sand=a.sand, rows=rows), indent=1))
+    (out / "bin_slab_compare.json").write_text(json.dumps(dict(gap=gap, case=a.case, sand=a.sand, size=a.size,
+                                                               cell=g["cell"], rows=rows), indent=1))
     return rows
 
 
@@ -194,7 +207,17 @@ def main(argv=None):
     p.add_argument("--bulkflow", default=str(Path(__file__).resolve().parents[3] / "build/bin/bulkflow"))
     p.add_argument("--out", default="out/bin_slab")
     p.add_argument("--reuse", action="store_true", help="compare: take runs of the same scene text from --out")
+    p.add_argument("--size", choices=("small", "thesis"), default="small",
+                   help="compare: the small bin of inputs/mpm/bin_small_* or the thesis's (outlet 11.8 mm)")
+    p.add_argument("--edge-cells", type=int, default=1, help="--size thesis: cell = outlet / (2k + 1)")
+    p.add_argument("--young", type=float, default=None, help="Young's modulus [Pa] (default Table 5.3's)")
+    p.add_argument("--pic-time", type=float, default=0.0, metavar="TAU",
+                   help="*MPM CONTROLS, PIC TIME=TAU [s] in every scene (0: FLIP=0.99)")
+    p.add_argument("--max-dilation", type=float, default=0.0, metavar="J",
+                   help="*MPM CONTROLS, MAX DILATION=J in every scene (0: off)")
     a = p.parse_args(argv)
+    if a.pic_time < 0 or (0 < a.max_dilation < 1) or a.max_dilation < 0 or a.edge_cells < 1:
+        p.error("--pic-time >= 0, --max-dilation 0 or >= 1, --edge-cells >= 1")
     if a.what == "compare":
         compare(a)
         return 0
