@@ -36,7 +36,7 @@ import argparse
 import math
 import sys
 
-from .hopper_scene import _num, eps_cv_from_eta
+from .hopper_scene import _num, controls_line, eps_cv_from_eta
 
 OUTLET = 0.0118              # m, thesis §5.1
 FILL = 0.200                 # m, initial material height
@@ -148,11 +148,7 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     # corners in full, so that the node lines fall on x = 0 and y = 0 to round-off
     w(f"{lo[0]:.15g}, {lo[1]:.15g}")
     w(f"{hi[0]:.15g}, {hi[1]:.15g}")
-    # MAX DILATION only when asked: the scene text (and the study's run cache) of before otherwise
-    held = f", MAX DILATION={max_dilation:g}" if max_dilation > 0 else ""
-    # PIC TIME (the blend as a rate, docs/theory/mpm.md 4.3) in place of FLIP only when asked
-    blend = f"PIC TIME={pic_time:g}" if pic_time > 0 else f"FLIP={flip:g}"
-    w(f"*MPM CONTROLS, {blend}, CFL={cfl:g}, DAMPING={fill_damping:g}{held}")
+    w(controls_line(flip, cfl, fill_damping, pic_time, max_dilation))
     if side_friction is not None:
         # front and back glass walls of the quasi-2D bin (issue 20 point 2, docs/keywords.md)
         w(f"*MPM SIDE FRICTION, GAP={side_friction:.9g}, FRICTION={mu:.7f}")

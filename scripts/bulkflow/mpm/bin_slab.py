@@ -32,6 +32,7 @@ import numpy as np
 
 from .bin_scene import (CASES, OUTLET, PHI_CV, PHI_WALL, POISSON, PSI_MAX, RHO_CV, RHO_I, SANDS, YOUNG,
                         _material, bin_geometry, bin_scene, bin_steps, eps_cv)
+from .hopper_scene import controls_line
 
 SMALL = dict(outlet=0.05, width=0.2, fill=0.2, cell=0.01)   # the small bin of inputs/mpm/bin_small_*
 
@@ -68,10 +69,7 @@ def slab_scene(case="concentric", sand="NDNS", gap_cells=4, cell=None, edge_cell
     w(f"*MPM GRID, CELL={h:.12g}, SHAPE=GIMP")
     w(f"{lo[0]:.15g}, {lo[1]:.15g}, {lo[2]:.15g}")
     w(f"{hi[0]:.15g}, {hi[1]:.15g}, {hi[2]:.15g}")
-    # as bin_scene: PIC TIME and MAX DILATION written only when asked
-    blend = f"PIC TIME={pic_time:g}" if pic_time > 0 else f"FLIP={flip:g}"
-    held = f", MAX DILATION={max_dilation:g}" if max_dilation > 0 else ""
-    w(f"*MPM CONTROLS, {blend}, CFL={cfl:g}, DAMPING={fill_damping:g}{held}")
+    w(controls_line(flip, cfl, fill_damping, pic_time, max_dilation))
     _material(w, sand, density, young, POISSON, PHI_CV, PSI_MAX, eps_cv(density, RHO_CV))
     x0, x1, xl, xr = g["x_out0"], g["x_out1"], g["x_left"], g["x_right"]
     w(f"*PARTICLES, MATERIAL=MC-SAND, PPC={ppc}, TYPE=POLYGON, Z1=0., Z2={_f(t)}")

@@ -132,6 +132,15 @@ def _output_lines(field_frames, history_dt):
             f"*OUTPUT, HISTORY, TIME INTERVAL={history_dt:g}", "*ENERGY OUTPUT"]
 
 
+def controls_line(flip, cfl, damping, pic_time=0.0, max_dilation=0.0):
+    """The model-data `*MPM CONTROLS` line of the scene generators: PIC TIME (the blend as a rate,
+    docs/theory/mpm.md 4.3) in place of FLIP and MAX DILATION only when asked, so that a scene
+    that asks for neither keeps its text (and the studies' run caches) of before."""
+    blend = f"PIC TIME={pic_time:g}" if pic_time > 0 else f"FLIP={flip:g}"
+    held = f", MAX DILATION={max_dilation:g}" if max_dilation > 0 else ""
+    return f"*MPM CONTROLS, {blend}, CFL={cfl:g}, DAMPING={damping:g}{held}"
+
+
 def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_friction=5.0,
                  fill_time=1.0, ramp=0.6, discharge_time=3.0, inflow=True, fill_damping=0.1,
                  flip=0.99, cfl=0.3, shape="GIMP", field_frames=10, history_dt=0.01,
@@ -168,9 +177,7 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w(f"*MPM GRID, CELL={cell:.12g}, SHAPE={shape}")
     w(f"{lo[0]:.9f}, {lo[1]:.9f}")
     w(f"{hi[0]:.9f}, {hi[1]:.9f}")
-    # PIC TIME (the blend as a rate, docs/theory/mpm.md 4.3) in place of FLIP only when asked
-    blend = f"PIC TIME={pic_time:g}" if pic_time > 0 else f"FLIP={flip:g}"
-    w(f"*MPM CONTROLS, {blend}, CFL={cfl:g}, DAMPING={fill_damping:g}")
+    w(controls_line(flip, cfl, fill_damping, pic_time))
     name = "DP-FILL" if model == "DP" else "MC-FILL"
     lines += material_lines(name, model=model, density=density, young=young, poisson=poisson, phi=phi,
                             psi_initial=psi_initial, eps_cv=eps_cv, psi_constant=psi_constant,
