@@ -36,16 +36,29 @@ module material_door
   integer, parameter, public :: n_vec_length = 136
 
   !> Arguments of a vumat call that the solver does not keep between increments.
+  !> A set is made once for up to `capacity` points (vumat_work_init) and then serves a call of
+  !> `rows` points (vumat_work_rows): the 2D/3D arrays the VUMAT sees as (nblock, ...) are views
+  !> of exactly `rows` rows into one store, so a set changes its row count without allocating
+  !> (the MPM's partial blocks change counts every few increments as particles leave and
+  !> arrive: re-making a set each time was 3 % of a rank's run, docs/scaling.md); the 1D
+  !> arrays have capacity rows (their (1:rows) sections are contiguous anyway); the new stress,
+  !> state and energies are allocatables of exactly `rows` rows, because the door swaps them
+  !> with the block's arrays instead of copying.
   type, public :: vumat_work_t
      character(len=8) :: point_kind = 'element'       !< what elem_number counts (messages)
+     integer :: capacity = 0                          !< most rows (vumat_work_init's nmax)
+     integer :: rows = 0                              !< rows of the views now
+     integer :: ncomp = 0, nshr = 0, nstatev = 0, nfieldv = 0
      integer, allocatable :: jblock(:)
-     real(dp), allocatable :: coord(:, :), temp(:), temp_new(:), stretch_old(:, :), stretch_new(:, :)
-     real(dp), allocatable :: defgrad_old(:, :), defgrad_new(:, :), field_new(:, :)
-     real(dp), allocatable :: stress_new(:, :), state_mid(:, :), state_new(:, :)
-     real(dp), allocatable :: e_int_new(:), e_inel_new(:), density(:), direct(:, :, :)
+     real(dp), allocatable :: temp(:), temp_new(:)
+     real(dp), pointer, contiguous :: coord(:, :) => null(), stretch_old(:, :) => null(), &
+          stretch_new(:, :) => null(), defgrad_old(:, :) => null(), defgrad_new(:, :) => null(), &
+          field_new(:, :) => null(), state_mid(:, :) => null(), direct(:, :, :) => null()
+     real(dp), pointer, contiguous :: store(:) => null()   !< the views' storage
+     real(dp), allocatable :: stress_new(:, :), state_new(:, :), e_int_new(:), e_inel_new(:)
   end type vumat_work_t
 
-  public :: vumat_work_init, call_material, call_field, packaging_modulus, checked_packaging_modulus
+  public :: vumat_work_init, vumat_work_rows, call_material, call_field, packaging_modulus, checked_packaging_modulus
   public :: packaging_moduli, checked_packaging_moduli
 
   !> The strain increment of the packaging call (direction 11).
@@ -58,29 +71,70 @@ module material_door
 
 contains
 
+  !> A set for up to nmax points, serving nmax rows (vumat_work_rows changes that).
   subroutine vumat_work_init(w, nmax, ncomp, nshr, nstatev, nfieldv)
     type(vumat_work_t), intent(inout) :: w
     integer, intent(in) :: nmax, ncomp, nshr, nstatev, nfieldv
-    integer :: k
 
-    if (allocated(w%jblock)) deallocate(w%jblock, w%coord, w%temp, w%temp_new, w%stretch_old, w%stretch_new, &
-         w%defgrad_old, w%defgrad_new, w%field_new, w%stress_new, w%state_mid, w%state_new, &
-         w%e_int_new, w%e_inel_new, w%density, w%direct)
-    allocate(w%jblock(4 + nmax), w%coord(nmax, 3), w%temp(nmax), w%temp_new(nmax))
-    allocate(w%stretch_old(nmax, ncomp), w%stretch_new(nmax, ncomp))
-    allocate(w%defgrad_old(nmax, ncomp + nshr), w%defgrad_new(nmax, ncomp + nshr))
-    allocate(w%field_new(nmax, max(1, nfieldv)), w%stress_new(nmax, ncomp))
-    allocate(w%state_mid(nmax, max(1, nstatev)), w%state_new(nmax, max(1, nstatev)))
-    allocate(w%e_int_new(nmax), w%e_inel_new(nmax), w%density(nmax), w%direct(nmax, 3, 3))
+    if (allocated(w%jblock)) deallocate(w%jblock, w%temp, w%temp_new)
+    if (associated(w%store)) deallocate(w%store)
+    w%capacity = nmax
+    w%ncomp = ncomp
+    w%nshr = nshr
+    w%nstatev = max(1, nstatev)
+    w%nfieldv = max(1, nfieldv)
+    allocate(w%jblock(4 + nmax), w%temp(nmax), w%temp_new(nmax))
+    allocate(w%store(nmax * view_columns(w)))
     w%jblock = 1
-    w%coord = 0
     w%temp = 0
     w%temp_new = 0
+    w%rows = -1
+    call vumat_work_rows(w, nmax)
+  end subroutine vumat_work_init
+
+  !> Columns of all views together (each view has its own `capacity`-row region of the store).
+  pure integer function view_columns(w)
+    type(vumat_work_t), intent(in) :: w
+    view_columns = 3 + 2 * w%ncomp + 2 * (w%ncomp + w%nshr) + w%nfieldv + w%nstatev + 9
+  end function view_columns
+
+  !> The set serves `rows` points (1 <= rows <= capacity): its views become (rows, ...) arrays,
+  !> coordMp zero and the direction cosines the identity in them (what a freshly made set holds;
+  !> the stretch and defgrad views are the caller's to fill), and the swapped arrays get exactly
+  !> `rows` rows. Nothing is done when the set has that count already.
+  subroutine vumat_work_rows(w, rows)
+    type(vumat_work_t), intent(inout) :: w
+    integer, intent(in) :: rows
+    integer :: off, k
+
+    if (rows == w%rows) return
+    if (rows < 1 .or. rows > w%capacity) call raise_error('vumat_work_rows', 0, &
+         'a work set asked for more rows than it was made for (internal error)')
+    off = 0
+    call view(w%coord, 3)
+    call view(w%stretch_old, w%ncomp)
+    call view(w%stretch_new, w%ncomp)
+    call view(w%defgrad_old, w%ncomp + w%nshr)
+    call view(w%defgrad_new, w%ncomp + w%nshr)
+    call view(w%field_new, w%nfieldv)
+    call view(w%state_mid, w%nstatev)
+    w%direct(1:rows, 1:3, 1:3) => w%store(off + 1:off + 9 * rows)
+    w%coord = 0
     w%direct = 0
     do k = 1, 3
        w%direct(:, k, k) = 1
     end do
-  end subroutine vumat_work_init
+    if (allocated(w%stress_new)) deallocate(w%stress_new, w%state_new, w%e_int_new, w%e_inel_new)
+    allocate(w%stress_new(rows, w%ncomp), w%state_new(rows, w%nstatev), w%e_int_new(rows), w%e_inel_new(rows))
+    w%rows = rows
+  contains
+    subroutine view(a, ncol)
+      real(dp), pointer, contiguous, intent(inout) :: a(:, :)
+      integer, intent(in) :: ncol
+      a(1:rows, 1:ncol) => w%store(off + 1:off + ncol * rows)
+      off = off + ncol * w%capacity
+    end subroutine view
+  end subroutine vumat_work_rows
 
   !> One increment of the material of a block: [vusdfld] then vumat. Arrays are the block's
   !> (nb, ...) arrays; on return stress/state/field/energies hold the new values.

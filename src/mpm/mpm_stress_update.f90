@@ -17,7 +17,7 @@ module mpm_stress_update
   use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_transfer, only: gather_gradient, gather_gradient_3d_packed
   use model_particle_fields, only: particle_temperature
-  use material_door, only: vumat_work_t, vumat_work_init, call_material, call_field
+  use material_door, only: vumat_work_t, vumat_work_init, vumat_work_rows, call_material, call_field
   use fem_corotation, only: polar_rotation, to_corotational, to_global, relative_spin, vumat_defgrad, &
        vumat_stretch
   use output_effects, only: effects_t
@@ -121,12 +121,14 @@ contains
          st%work(iw))
   end subroutine field_update
 
-  !> The work set of block b, with exactly its count of rows (material_work_init), and the point
-  !> data the VUSDFLD and the VUMAT read from it: coordMp (the particle's position, third
-  !> column 0 in 2D; only for the materials that read it) and tempOld, tempNew (the material's
-  !> particle temperature at t_n and t_n+1, driver_temperature).
-  !> A partial block takes the set made for its count; when no set has it, an unmade set, or else
-  !> the sets are re-made in turn. Which set serves a block does not change its results: what the
+  !> The work set of block b, with exactly its count of rows, and the point data the VUSDFLD
+  !> and the VUMAT read from it: coordMp (the particle's position, third column 0 in 2D; only
+  !> for the materials that read it) and tempOld, tempNew (the material's particle temperature
+  !> at t_n and t_n+1, driver_temperature).
+  !> A partial block takes the set that has its count; when none has it, an unmade set (made for
+  !> a full block's count once), or else the sets in turn, which then take the block's count
+  !> (vumat_work_rows: views of their storage, no allocation but the four swapped arrays'). Which
+  !> set serves a block does not change its results: what the
   !> material reads from a set is written before the call (here, stress_update, the door) or is
   !> the same in every set of that count (U = F = I and zero coordinates where not written).
   subroutine block_work_set(m, st, b, iw)
@@ -151,10 +153,11 @@ contains
        if (iw == 0) then
           st%work_replace = 1 + mod(st%work_replace, size(st%work) - 1)
           iw = 1 + st%work_replace
-          st%work_rows(iw) = 0
        end if
-       if (st%work_rows(iw) == 0) then
-          call material_work_init(st, st%work(iw), nb)
+       if (st%work(iw)%capacity == 0) call material_work_init(st, st%work(iw), particle_block_size)
+       if (st%work_rows(iw) /= nb) then
+          call vumat_work_rows(st%work(iw), nb)
+          call unit_kinematics(st%work(iw))
           st%work_rows(iw) = nb
        end if
     end if
@@ -233,13 +236,19 @@ contains
 
     call vumat_work_init(w, rows, st%nc, st%nshr, st%work_statev, st%work_fieldv)
     w%point_kind = 'particle'
+    call unit_kinematics(w)
+  end subroutine material_work_init
+
+  !> U = F = I in the set's rows (stay so for the materials that do not read them).
+  subroutine unit_kinematics(w)
+    type(vumat_work_t), intent(inout) :: w
     w%stretch_old = 0
     w%stretch_old(:, 1:3) = 1
     w%defgrad_old = 0
     w%defgrad_old(:, 1:3) = 1
     w%stretch_new = w%stretch_old
     w%defgrad_new = w%defgrad_old
-  end subroutine material_work_init
+  end subroutine unit_kinematics
 
   subroutine inverted(m, st, b, p)
     type(model_t), intent(in) :: m
