@@ -4,7 +4,7 @@
     .venv/bin/python scripts/bench_mpm.py [--bulkflow build/bin/bulkflow] [--increments 3000]
                                          [--compare OLD_BINARY [--rounds 3]]
                                          [--discharge SECONDS --cell H --np N
-                                          --discharge-sort N --decomposition spatial]
+                                          --discharge-sort N --decomposition spatial [--timing]]
 
 1. The ch. 4 wedge hopper's FILL step (--stop-after N increments) in 2D (cell 0.05 m, 2x2 PPC,
    uGIMP and linear shapes) and in 3D (the same wedge as a slab of 4 cells between two mirrored
@@ -290,6 +290,14 @@ def discharge(tmp, a):
     hist = np.genfromtxt(str(tmp / "hopper_discharge_history.csv"), delimiter=",", names=True)
     print(f"    steady MDR (full hopper, from 0.5 s after opening): {2 * mean_discharge_rate(hist):.1f} kg/s/m; "
           f"history: {tmp / 'hopper_discharge_history.csv'}")
+    if a.timing:
+        # the solver's end report: its timing table (max and mean over the ranks) and the
+        # decomposition's counts, where a 2-rank run's extra time shows
+        m = re.search(r"^.*ranks, \d+ re-partitions.*$", r.stdout, re.M)
+        if m:
+            print("    " + m.group(0).strip())
+        m = re.search(r"^timing \(.*?(?=^\S|\Z)", r.stdout, re.M | re.S)
+        print("    " + (m.group(0).rstrip().replace("\n", "\n    ") if m else "(no timing table in the solver's output)"))
 
 
 def main():
@@ -310,6 +318,8 @@ def main():
     p.add_argument("--decomposition", choices=("replicated", "spatial"), default="replicated",
                    help="--discharge: *MPM CONTROLS, DECOMPOSITION= (default replicated)")
     p.add_argument("--skip-throughput", action="store_true", help="only the --discharge run")
+    p.add_argument("--timing", action="store_true",
+                   help="--discharge: also print the solver's timing table (max and mean over the ranks)")
     a = p.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="bench_mpm_"))
     print(f"bulkflow MPM benchmark ({a.bulkflow}); scratch {tmp}")
