@@ -7,11 +7,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from . import arching_cow, bin_tss, hopper_mdr, incline, k0_column, wave_bar
+from . import arching_cow, bin_mdr, bin_tss, hopper_mdr, incline, k0_column, wave_bar
 from .study import resummarise, run_family
 
 KINDS = {k["name"]: k for k in (wave_bar.KIND, wave_bar.KIND_BV, k0_column.KIND, incline.KIND, hopper_mdr.KIND,
-                                 arching_cow.KIND, bin_tss.KIND)}
+                                 arching_cow.KIND, bin_tss.KIND, bin_mdr.KIND)}
+# the kinds whose scenes take *MPM CONTROLS, PIC TIME and the μ(I) block
+MPM_FLOW = {"hopper-mdr": hopper_mdr, "bin-tss": bin_tss, "bin-mdr": bin_mdr}
+REGULARISED = ("hopper-mdr", "bin-mdr")
 NOT_DONE: tuple[str, ...] = ()
 
 
@@ -24,9 +27,14 @@ def main(argv=None) -> int:
     parser.add_argument("--solver", default=None, help="bulkflow binary (default BULKFLOW_BIN or build/bin/bulkflow)")
     parser.add_argument("--criterion", default=None,
                         help="arching-cow only: the flow criterion, passed to bulkflow.arching when it takes one")
-    parser.add_argument("--pic-time", type=float, default=0.0, metavar="TAU",
-                        help="hopper-mdr and bin-tss only: *MPM CONTROLS, PIC TIME=TAU [s] in every member, "
-                             "the PIC/FLIP blend as a rate (docs/accuracy.md); 0: the scenes' FLIP=0.99")
+    parser.add_argument("--pic-time", type=float, default=None, metavar="TAU",
+                        help="hopper-mdr, bin-tss, bin-mdr: *MPM CONTROLS, PIC TIME=TAU [s] in every member, "
+                             "the PIC/FLIP blend as a rate (docs/accuracy.md); 0: FLIP=0.99 (the default of "
+                             "hopper-mdr and bin-tss; bin-mdr's is 0.01)")
+    parser.add_argument("--inertial-friction", default=None, metavar="PHI2,I0,D,RHOS",
+                        help="hopper-mdr, bin-mdr: the regularised family, μ(I) in every member's Mohr-Coulomb "
+                             "sand (docs/mu_of_i.md: φ2 [deg], I0, grain diameter d [m], grain density [kg/m3]); "
+                             "default output folder out/accuracy/KIND-mu-i")
     parser.add_argument("--summarise-only", action="store_true",
                         help="no runs: the summary and outputs again from the measured rows of OUT/KIND.json")
     args = parser.parse_args(argv)
@@ -42,13 +50,24 @@ def main(argv=None) -> int:
         if arching_cow.criterion_supported() is None:
             parser.error("--criterion: this checkout's bulkflow.arching has no flow criterion option")
         arching_cow.CRITERION = args.criterion
-    if args.pic_time:
-        if args.kind not in ("hopper-mdr", "bin-tss"):
-            parser.error("--pic-time applies to hopper-mdr and bin-tss only")
+    if args.pic_time is not None:
+        if args.kind not in MPM_FLOW:
+            parser.error(f"--pic-time applies to {', '.join(MPM_FLOW)} only")
         if args.pic_time < 0:
             parser.error("--pic-time must be >= 0")
-        (hopper_mdr if args.kind == "hopper-mdr" else bin_tss).PIC_TIME = args.pic_time
-    out = args.out or Path("out") / "accuracy" / args.kind
+        MPM_FLOW[args.kind].PIC_TIME = args.pic_time
+    suffix = ""
+    if args.inertial_friction is not None:
+        if args.kind not in REGULARISED:
+            parser.error(f"--inertial-friction applies to {', '.join(REGULARISED)} only")
+        block = inertial_friction_block(args.inertial_friction)
+        if isinstance(block, str):
+            parser.error(f"--inertial-friction {args.inertial_friction!r}: {block}")
+        MPM_FLOW[args.kind].INERTIAL_FRICTION = block
+        kind = dict(kind, title=f"{kind['title']}, with μ(I) (φ2 {block[0]:g}°, I0 {block[1]:g}, "
+                                f"d {block[2]:g} m, ρs {block[3]:g} kg/m³)")
+        suffix = "-mu-i"
+    out = args.out or Path("out") / "accuracy" / f"{args.kind}{suffix}"
     print(f"{kind['name']}: {kind['title']}{' (quick)' if args.quick else ''}")
     if args.summarise_only:
         if not (out / f"{kind['name']}.json").exists():
@@ -81,6 +100,23 @@ def main(argv=None) -> int:
         print(f"also {e['what']}: {ref}")
     print(f"wrote {out / kind['name']}.csv, .png, .json, .md")
     return 0
+
+
+def inertial_friction_block(text: str):
+    """(φ2, I0, d, ρs) from "PHI2,I0,D,RHOS", or what is wrong with it (a str): the ranges of
+    *INERTIAL FRICTION (docs/keywords.md), which the solver checks again against the sand's φ."""
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        return "expected four numbers PHI2,I0,D,RHOS"
+    if len(vals) != 4:
+        return f"expected four numbers PHI2,I0,D,RHOS, got {len(vals)}"
+    phi2, i0, d, rho_s = vals
+    if not 0 < phi2 <= 89:
+        return "φ2 must be in (0, 89] degrees"
+    if not (i0 > 0 and d > 0 and rho_s > 0):
+        return "I0, d and ρs must be > 0"
+    return vals
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..mpm.discharge import mean_discharge_rate
 from ..mpm.hopper_run import scene_text
+from ..mpm.study_mu_of_i import with_mu_of_i
 from .runs import particles_from_log
 
 EDGE_CELLS = [1.5, 2.5, 3.5, 4.5, 5.5]
@@ -29,6 +30,8 @@ FULL = dict(height=3.0, fill_time=1.0, discharge_time=1.5)
 QUICK = dict(height=1.0, fill_time=0.5, ramp=0.3, discharge_time=1.0)
 # bulkflow-accuracy --pic-time: *MPM CONTROLS, PIC TIME in every member (0: the scene's FLIP=0.99)
 PIC_TIME = 0.0
+# bulkflow-accuracy --inertial-friction: (φ2 [deg], I0, d [m], ρs [kg/m3]) or None (static MC)
+INERTIAL_FRICTION = None
 
 
 def members(quick: bool) -> list[dict]:
@@ -45,7 +48,12 @@ def scene(member: dict) -> str:
     if PIC_TIME > 0:
         kw["pic_time"] = PIC_TIME
     # 2 particle frames in the fill step, 6 in the discharge: the wall force averages the last 3
-    return scene_text(cell=member["cell"], ppc=2, shape="GIMP", field_frames=2, discharge_frames=6, **kw)
+    text = scene_text(cell=member["cell"], ppc=2, shape="GIMP", field_frames=2, discharge_frames=6, **kw)
+    if INERTIAL_FRICTION is not None:
+        # the μ(I) block appended to the sand's MC constants (the scene's material is a *USER
+        # MATERIAL with its VUSDFLD: umat/README.md props layout, docs/mu_of_i.md)
+        text = with_mu_of_i(text, "1., " + ", ".join(f"{v:.9g}" for v in INERTIAL_FRICTION))
+    return text
 
 
 def wall_force(base, cell: float) -> float:

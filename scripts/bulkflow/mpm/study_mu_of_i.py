@@ -27,13 +27,14 @@ from bulkflow.mpm.hopper_scene import hopper_scene
 MU_OF_I_BLOCK = "1., 37.1, 0.279, 0.5e-3, 2500."
 
 
-def with_mu_of_i(text):
-    """The scene with the mu(I) block appended to its MC *USER MATERIAL constants."""
+def with_mu_of_i(text, block=MU_OF_I_BLOCK):
+    """The scene with the mu(I) block ("1., phi2, I0, d, rho_s") appended to its MC *USER
+    MATERIAL constants."""
     m = re.search(r"\*USER MATERIAL, CONSTANTS=(\d+)\n((?:[^*].*\n)+)", text)
     if m is None:
         sys.exit("no *USER MATERIAL in the scene")
     n = int(m.group(1)) + 5
-    body = m.group(2).rstrip("\n").rstrip(",") + ",\n" + MU_OF_I_BLOCK + "\n"
+    body = m.group(2).rstrip("\n").rstrip(",") + ",\n" + block + "\n"
     return text[:m.start()] + f"*USER MATERIAL, CONSTANTS={n}\n" + body + text[m.end():]
 
 
