@@ -52,3 +52,47 @@ def test_smooth_glass_keeps_the_bins_wall_friction():
                             width=SMALL["width"], fill=SMALL["fill"])
     assert "NAME=FRONT, FRICTION=0.0000000" in text and "NAME=BACK, FRICTION=0.0000000" in text
     assert f"NAME=RIGHT, FRICTION={math.tan(math.radians(7.0)):.7f}" in text
+
+
+def _frame_file(path, x, s, t=0.3):
+    """A particle file with one frame at total time t, the datasets glass_at_rest reads."""
+    import h5py
+    with h5py.File(path, "w") as f:
+        g = f.create_group("particles").create_group("000001")
+        g.attrs["total_time"] = [t]
+        g["coordinates"] = x
+        g["S"] = s
+
+
+def test_glass_at_rest_reads_k_and_the_mobilised_friction_of_the_glass_layers(tmp_path):
+    import numpy as np
+
+    from bulkflow.mpm.bin_slab import glass_at_rest
+
+    mu = math.tan(math.radians(7.0))
+    rng = np.random.default_rng(3)
+    rows = []
+    for y in (0.05, 0.15):                       # two height bands of a 0.2 m fill
+        for z in (0.002, 0.006, 0.010, 0.014):   # four layers across the gap, jittered below
+            for xx in (0.05, 0.06):
+                syy = -1000.0 * (0.2 - y) / 0.2
+                szz = 0.43 * syy
+                glass = z in (0.002, 0.014)
+                # the glass layers hold half the Coulomb limit low down, all of it high up; the
+                # inner layers' shear is not the glass's and must not count
+                mob = (0.5 if y < 0.1 else 1.0) if glass else 0.1
+                syz = np.sign(z - 0.008) * mob * mu * abs(szz)
+                rows.append(([xx, y, z + rng.uniform(-2e-4, 2e-4)], [0.43 * syy, syy, szz, 0.0, syz, 0.0]))
+    x = np.array([r[0] for r in rows])
+    s = np.array([r[1] for r in rows])
+    _frame_file(tmp_path / "slab.h5", x, s)
+    res = glass_at_rest(tmp_path / "slab", 0.3, (0.0, 0.1), mu, 0.2, bands=2)
+    assert [r["K"] for r in res] == pytest.approx([0.43, 0.43])
+    assert [r["mobilised"] for r in res] == pytest.approx([0.5, 1.0])
+    # a 2D file (out-of-plane coordinate 0, four stress columns): K only
+    x2 = x.copy()
+    x2[:, 2] = 0
+    _frame_file(tmp_path / "flat.h5", x2, s[:, :4])
+    res = glass_at_rest(tmp_path / "flat", 0.3, (0.0, 0.1), mu, 0.2, bands=2)
+    assert [r["mobilised"] for r in res] == [None, None]
+    assert [r["K"] for r in res] == pytest.approx([0.43, 0.43])

@@ -137,6 +137,42 @@ def base_stress_at_rest(base: Path, time_at_rest: float, x_range: tuple[float, f
     return float(np.mean(s[low, 1]))
 
 
+def glass_at_rest(base: Path, time_at_rest: float, x_range: tuple[float, float], mu: float, fill: float,
+                  bands: int = 5) -> list[dict]:
+    """How the glass holds the sand at rest, by height (`bands` bands of the fill, particles within
+    x_range): K = σzz/σyy (the glass's normal stress over the vertical stress) and, in a 3D slab,
+    the mobilised friction |σyz|/(μ |σzz|) of the particle layer next to each glass wall (1: the
+    Coulomb limit everywhere, Janssen's assumption and what the 2D body force holds at rest; Abaqus
+    stress order 11 22 33 12 23 31, so σyz is column 5). In 2D `mobilised` is None."""
+    import h5py
+    with h5py.File(f"{base}.h5", "r") as f:
+        frames = f["particles"]
+        key = min(frames, key=lambda k: abs(float(frames[k].attrs["total_time"][0]) - time_at_rest))
+        x = frames[key]["coordinates"][()]
+        s = frames[key]["S"][()]
+    inside = (x[:, 0] > x_range[0]) & (x[:, 0] < x_range[1])
+    three_d = s.shape[1] >= 6 and np.ptp(x[:, 2]) > 0
+    if three_d:
+        # the particle layers across the gap, told apart by the gaps between them (the particles
+        # have moved a little in z since they were placed): the first and the last touch the glass
+        z = x[:, 2]
+        zs = np.sort(z)
+        cuts = np.flatnonzero(np.diff(zs) > 0.1 * np.ptp(z))
+        glass = np.ones(len(z), bool) if len(cuts) == 0 else (z <= zs[cuts[0]]) | (z >= zs[cuts[-1] + 1])
+    rows = []
+    edges = np.linspace(0.0, fill, bands + 1)
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        band = inside & (x[:, 1] >= lo) & (x[:, 1] < hi)
+        if not band.any():
+            continue
+        row = {"y": 0.5 * (lo + hi), "K": float(s[band, 2].mean() / s[band, 1].mean()), "mobilised": None}
+        if three_d and (band & glass).any():
+            g = band & glass
+            row["mobilised"] = float(np.abs(s[g, 4]).mean() / (mu * np.abs(s[g, 2]).mean()))
+        rows.append(row)
+    return rows
+
+
 def discharged_per_metre(hist: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
     """Discharge-step time and the discharged mass per metre of depth (whole bin)."""
     d = hist["step"] == 2
@@ -177,7 +213,9 @@ def compare(a: argparse.Namespace) -> dict:
         hist, wall = _run(a.bulkflow, text, out / file_name, a.reuse)
         t, m = discharged_per_metre(hist, scale)
         rows[name] = dict(rate=mean_rate(t, m), wall=wall, t=t.tolist(), mass=m.tolist(),
-                          base_stress=base_stress_at_rest(out / file_name, 0.3, x_range, 0.5 * g["cell"] / a.ppc))
+                          base_stress=base_stress_at_rest(out / file_name, 0.3, x_range, 0.5 * g["cell"] / a.ppc),
+                          at_rest=glass_at_rest(out / file_name, 0.3, x_range, math.tan(math.radians(PHI_WALL)),
+                                                g["fill"]))
     print(f"{a.size} {a.case} bin ({a.sand}, outlet {common.get('outlet', OUTLET) * 1e3:g} mm, cell {g['cell'] * 1e3:.4g} mm, "
           f"PPC {a.ppc}, E {common.get('young', YOUNG) / 1e6:g} MPa"
           + (f", PIC TIME {a.pic_time:g} s" if a.pic_time > 0 else "")
@@ -186,9 +224,17 @@ def compare(a: argparse.Namespace) -> dict:
     print("  scene                  base sigma_yy at rest [Pa]  vs 3D slab | MDR [kg/s/m]  vs 3D slab | "
           "discharged [kg/m]  wall [s]")
     ref, sref = rows["3D slab"]["rate"], rows["3D slab"]["base_stress"]
+    def ratio(v, r):    # a run too short for a rate has none (nan or 0): no ratio either
+        return f"{v / r:11.3f}" if r and math.isfinite(r) and math.isfinite(v) else f"{'-':>11s}"
     for name, r in rows.items():
-        print(f"  {name:22s} {r['base_stress']:14.1f} {r['base_stress'] / sref:17.4f} | {r['rate']:11.3f} "
-              f"{r['rate'] / ref:11.3f} | {r['mass'][-1]:12.3f} {r['wall']:9.1f}")
+        print(f"  {name:22s} {r['base_stress']:14.1f} {ratio(r['base_stress'], sref):>17s} | {r['rate']:11.3f} "
+              f"{ratio(r['rate'], ref)} | {r['mass'][-1]:12.3f} {r['wall']:9.1f}")
+    print("  at rest (end of fill), by height: K = sigma_zz/sigma_yy; slab: mobilised glass friction "
+          "|sigma_yz|/(mu |sigma_zz|) of the particle layer at each glass wall")
+    for name, r in rows.items():
+        cells = "  ".join(f"y {b['y'] * 1e3:.0f} mm K {b['K']:.3f}"
+                          + (f" mob {b['mobilised']:.3f}" if b["mobilised"] is not None else "") for b in r["at_rest"])
+        print(f"  {name:22s} {cells}")
     (out / "bin_slab_compare.json").write_text(json.dumps(dict(gap=gap, case=a.case, sand=a.sand, size=a.size,
                                                                cell=g["cell"], rows=rows), indent=1))
     return rows
