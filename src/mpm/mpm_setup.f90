@@ -170,7 +170,6 @@ contains
     st%work_statev = nsv
     st%work_fieldv = nfv
     call material_work_init(st, st%work(1), particle_block_size)
-    st%work_rows(1) = particle_block_size
   end subroutine setup_state
 
   !> The MPM's effects, declared into the run's registry: active when the scene asks for them.

@@ -56,15 +56,14 @@ module mpm_state
      real(dp), allocatable :: gpack(:, :)
      real(dp), allocatable :: modulus(:)             !< per material: λ + 2G (packaging call)
      logical, allocatable :: needs_kinematics(:)     !< per material: user VUMAT reads F, U
-     !> VUMAT work sets: work(1) has particle_block_size rows (full blocks), work(2:) the rows of
-     !> partial blocks, one set per count (work_rows), made when a count comes that no set has.
+     !> VUMAT work sets: work(1) serves full blocks (particle_block_size rows), work(2:) the
+     !> partial blocks, each set taking a block's count of rows (its `rows`, 0: not made yet).
      !> Why exactly nb rows: every (1:nb, ...) section the door passes is the whole, contiguous
      !> array (no pack/unpack copies) and the new stress and state are swapped in, not copied.
-     !> Why several: a rank holds several partial blocks of different counts that keep their
-     !> counts for many increments (migration leaves holes, the sort keeps counts); with one
-     !> partial set they took turns re-making it at every increment (docs/scaling.md).
+     !> Why several: a rank holds several partial blocks of different counts; a set that has a
+     !> block's count serves it as it is, another takes the count without allocating
+     !> (vumat_work_rows: its views re-pointed; docs/scaling.md).
      type(vumat_work_t) :: work(1 + partial_work_sets)
-     integer :: work_rows(1 + partial_work_sets) = 0  !< rows of each set (0: not made)
      integer :: work_replace = 1                      !< the partial set a miss re-makes when all are made
      integer :: work_statev = 1, work_fieldv = 1     !< columns of the work sets (largest of the materials)
      integer :: next_number = 0

@@ -145,7 +145,7 @@ contains
     if (nb /= particle_block_size) then
        iw = 0
        do k = 2, size(st%work)
-          if (st%work_rows(k) == nb .or. st%work_rows(k) == 0) then
+          if (st%work(k)%rows == nb .or. st%work(k)%rows == 0) then
              iw = k
              exit
           end if
@@ -155,10 +155,9 @@ contains
           iw = 1 + st%work_replace
        end if
        if (st%work(iw)%capacity == 0) call material_work_init(st, st%work(iw), particle_block_size)
-       if (st%work_rows(iw) /= nb) then
+       if (st%work(iw)%rows /= nb) then
           call vumat_work_rows(st%work(iw), nb)
           call unit_kinematics(st%work(iw))
-          st%work_rows(iw) = nb
        end if
     end if
     if (st%needs_kinematics(b%material)) st%work(iw)%coord(1:nb, 1:st%nd) = b%x(1:nb, 1:st%nd)
