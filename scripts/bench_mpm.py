@@ -4,7 +4,8 @@
     .venv/bin/python scripts/bench_mpm.py [--bulkflow build/bin/bulkflow] [--increments 3000]
                                          [--compare OLD_BINARY [--rounds 3]]
                                          [--discharge SECONDS --cell H --np N
-                                          --discharge-sort N --decomposition spatial [--timing]]
+                                          --discharge-sort N --decomposition spatial [--timing]
+                                          [--capacity]]
 
 1. The ch. 4 wedge hopper's FILL step (--stop-after N increments) in 2D (cell 0.05 m, 2x2 PPC,
    uGIMP and linear shapes) and in 3D (the same wedge as a slab of 4 cells between two mirrored
@@ -28,6 +29,9 @@
    bulkflow-mpm-study convergence, src/mpm/README.md), on --np ranks, the wall time per simulated
    second and the MDR; --discharge-sort N and --decomposition spatial run it with cell-ordered
    particles and the spatial decomposition (target: under 150 s for 5 s of discharge on 2 cores).
+4. --capacity (with --discharge): the machine's capacity around the --np run — two 1-rank runs
+   at once, the --np run, one 1-rank run alone, back to back — and the speed-up as a share of it
+   (docs/scaling.md: on this 2-core VM the capacity itself moves between about 1.6 and 1.9).
 Needs the release build (scripts/build.sh release).
 """
 import argparse
@@ -248,8 +252,8 @@ def compare(tmp, a):
           f" load average at the end {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
 
 
-def discharge(tmp, a):
-    env = mpi_env()
+def discharge_scene(tmp, a):
+    """The --discharge deck (SORT and decomposition as asked) and how it was made."""
     scene = tmp / "hopper_discharge.inp"
     scene.write_text(hopper_scene(cell=a.cell, discharge_time=a.discharge, field_frames=5, history_dt=0.01))
     how = "block order (SORT=0)"
@@ -262,6 +266,12 @@ def discharge(tmp, a):
         scene = tmp / f"{scene.stem}_{a.decomposition}.inp"
         scene.write_text(text)
     how += f", {a.decomposition} decomposition"
+    return scene, how
+
+
+def discharge(tmp, a):
+    env = mpi_env()
+    scene, how = discharge_scene(tmp, a)
     # not --quiet: the solver's "step 1/2 ... done ... wall X s" line splits the fill from the discharge
     cmd = [a.bulkflow, str(scene), "--output", str(tmp / "hopper_discharge")]
     if a.np > 1:
@@ -300,6 +310,41 @@ def discharge(tmp, a):
         print("    " + (m.group(0).rstrip().replace("\n", "\n    ") if m else "(no timing table in the solver's output)"))
 
 
+def capacity(tmp, a):
+    """--capacity: what this machine gives two jobs at once, around the --np run: two 1-rank runs
+    of the discharge deck at once, the --np run, then one 1-rank run alone (back to back, so all
+    see the same hour). Prints the capacity 2 T1/T(two at once), the speed-up T1/Tnp and the
+    speed-up over the capacity: an MPI run cannot beat two jobs that never wait for each other."""
+    env = mpi_env()
+    scene, how = discharge_scene(tmp, a)
+
+    def solver(name):
+        return [a.bulkflow, str(scene), "--output", str(tmp / name), "--quiet"]
+
+    t0 = time.perf_counter()
+    pair = [subprocess.Popen(solver(f"cap{k}"), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+            for k in (1, 2)]
+    walls = []
+    for proc in pair:
+        err = proc.communicate()[1]
+        walls.append(time.perf_counter() - t0)
+        if proc.returncode != 0:
+            sys.exit(f"bench_mpm --capacity: a 1-rank run failed:\n{err[-2000:]}")
+    both = statistics.mean(walls)
+    cmd = solver("capnp")
+    if a.np > 1:
+        cmd = ["mpirun", "-np", str(a.np)] + cmd
+    r, t_np = run(cmd, env=env)
+    r1, t_1 = run(solver("cap1alone"), env=env)
+    if r.returncode != 0 or r1.returncode != 0:
+        sys.exit(f"bench_mpm --capacity: a run failed:\n{(r.stderr + r1.stderr)[-2000:]}")
+    cap = 2 * t_1 / both
+    print(f"  capacity ({how}, 1 s fill + {a.discharge:g} s discharge): two 1-rank runs at once "
+          f"{walls[0]:.1f} / {walls[1]:.1f} s, one alone {t_1:.1f} s: the machine gives two jobs {cap:.2f} "
+          f"times one's speed now")
+    print(f"    {a.np} ranks {t_np:.1f} s: speed-up {t_1 / t_np:.2f}, {100 * t_1 / t_np / cap:.0f} % of the capacity")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--bulkflow", default=str(root.parent / "build" / "bin" / "bulkflow"))
@@ -318,6 +363,9 @@ def main():
     p.add_argument("--decomposition", choices=("replicated", "spatial"), default="replicated",
                    help="--discharge: *MPM CONTROLS, DECOMPOSITION= (default replicated)")
     p.add_argument("--skip-throughput", action="store_true", help="only the --discharge run")
+    p.add_argument("--capacity", action="store_true",
+                   help="--discharge: also measure the machine's 2-job capacity around an --np run "
+                        "(two 1-rank runs at once, the --np run, one 1-rank run alone)")
     p.add_argument("--timing", action="store_true",
                    help="--discharge: also print the solver's timing table (max and mean over the ranks)")
     a = p.parse_args()
@@ -329,6 +377,8 @@ def main():
         plain(tmp, a)
     if a.discharge > 0:
         discharge(tmp, a)
+        if a.capacity:
+            capacity(tmp, a)
 
 
 if __name__ == "__main__":
