@@ -55,12 +55,12 @@ def main():
         decks = DECKS
         if a.cell > 0:
             sys.path.insert(0, str(ROOT / "scripts"))
-            from bulkflow.mpm.hopper_scene import hopper_scene
-            from bulkflow.mpm.study_mu_of_i import with_mu_of_i
+            from bulkflow.mpm.hopper_scene import hopper_scene, with_mu_of_i
+            from bulkflow.mpm.study_mu_of_i import MU_OF_I_BLOCK
             text = hopper_scene(cell=a.cell, discharge_time=a.discharge, field_frames=2)
             decks = {"static": Path(tmp) / "hopper_mc.inp", "mu(I)": Path(tmp) / "hopper_mui.inp"}
             decks["static"].write_text(text)
-            decks["mu(I)"].write_text(with_mu_of_i(text))
+            decks["mu(I)"].write_text(with_mu_of_i(text, MU_OF_I_BLOCK))
         for rnd in range(a.rounds):
             for name, deck in decks.items():
                 steps, rate, cpu = one_run(a.bulkflow, deck, Path(tmp) / f"{rnd}_{deck.stem}", a.stop_after)

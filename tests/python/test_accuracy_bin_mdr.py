@@ -85,17 +85,17 @@ def test_measure_stops_at_the_end_of_steady_discharge(tmp_path):
     assert res["value"] == pytest.approx(8.0, rel=1e-9)
 
 
-def test_command_line_checks(capsys):
+@pytest.mark.parametrize("argv, message", [
+    (["wave-bar", "--inertial-friction", "55,0.3,1e-3,2650"], "applies to hopper-mdr, bin-mdr only"),
+    (["bin-mdr", "--inertial-friction", "55,0.3,1e-3"], "expected four numbers"),
+    (["bin-mdr", "--inertial-friction", "95,0.3,1e-3,2650"], "(0, 89]"),
+    (["k0-column", "--pic-time", "0.01"], "--pic-time applies to"),
+])
+def test_command_line_refuses(argv, message, capsys):
     with pytest.raises(SystemExit):
-        cli.main(["wave-bar", "--inertial-friction", "55,0.3,1e-3,2650"])
-    assert "applies to hopper-mdr, bin-mdr only" in capsys.readouterr().err
-    with pytest.raises(SystemExit):
-        cli.main(["bin-mdr", "--inertial-friction", "55,0.3,1e-3"])
-    assert "expected four numbers" in capsys.readouterr().err
-    with pytest.raises(SystemExit):
-        cli.main(["bin-mdr", "--inertial-friction", "95,0.3,1e-3,2650"])
-    assert "(0, 89]" in capsys.readouterr().err
-    with pytest.raises(SystemExit):
-        cli.main(["k0-column", "--pic-time", "0.01"])
-    assert "--pic-time applies to" in capsys.readouterr().err
+        cli.main(argv)
+    assert message in capsys.readouterr().err
+
+
+def test_inertial_friction_block_reads_four_numbers():
     assert cli.inertial_friction_block("55.2, 0.279, 0.71e-3, 2650") == (55.2, 0.279, 0.71e-3, 2650.0)

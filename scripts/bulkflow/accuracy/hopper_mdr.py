@@ -21,7 +21,7 @@ import numpy as np
 
 from ..mpm.discharge import mean_discharge_rate
 from ..mpm.hopper_run import scene_text
-from ..mpm.study_mu_of_i import with_mu_of_i
+from ..mpm.hopper_scene import with_mu_of_i
 from .runs import particles_from_log
 
 EDGE_CELLS = [1.5, 2.5, 3.5, 4.5, 5.5]

@@ -20,6 +20,7 @@ eps_cv = ln(eta_i/eta_cv), see `eps_cv_from_eta`), `young`, `poisson`, `density`
 """
 import argparse
 import math
+import re
 import shlex
 import sys
 
@@ -211,6 +212,18 @@ def command_line(argv):
         elif not (x.startswith("--output=") or (x.startswith("-o") and not x.startswith("--"))):
             args.append(shlex.quote(x))
     return " ".join(["bulkflow-make-mpm-hopper", *args, "-o", "FILE"])
+
+
+
+def with_mu_of_i(text, block):
+    """The scene with the mu(I) block `block` ("1., phi2, I0, d, rho_s": umat/README.md props
+    layout, docs/mu_of_i.md) appended to its Mohr-Coulomb *USER MATERIAL constants."""
+    m = re.search(r"\*USER MATERIAL, CONSTANTS=(\d+)\n((?:[^*].*\n)+)", text)
+    if m is None:
+        raise ValueError("no *USER MATERIAL in the scene to append the mu(I) block to")
+    n = int(m.group(1)) + 5
+    body = m.group(2).rstrip("\n").rstrip(",") + ",\n" + block + "\n"
+    return text[:m.start()] + f"*USER MATERIAL, CONSTANTS={n}\n" + body + text[m.end():]
 
 
 def main(argv=None):

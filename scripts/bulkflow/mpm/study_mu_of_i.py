@@ -22,20 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from bulkflow.mpm.discharge import mean_discharge_rate
-from bulkflow.mpm.hopper_scene import hopper_scene
+from bulkflow.mpm.hopper_scene import hopper_scene, with_mu_of_i
 
 MU_OF_I_BLOCK = "1., 37.1, 0.279, 0.5e-3, 2500."
-
-
-def with_mu_of_i(text, block=MU_OF_I_BLOCK):
-    """The scene with the mu(I) block ("1., phi2, I0, d, rho_s") appended to its MC *USER
-    MATERIAL constants."""
-    m = re.search(r"\*USER MATERIAL, CONSTANTS=(\d+)\n((?:[^*].*\n)+)", text)
-    if m is None:
-        sys.exit("no *USER MATERIAL in the scene")
-    n = int(m.group(1)) + 5
-    body = m.group(2).rstrip("\n").rstrip(",") + ",\n" + block + "\n"
-    return text[:m.start()] + f"*USER MATERIAL, CONSTANTS={n}\n" + body + text[m.end():]
 
 
 def main(argv=None):
@@ -51,7 +40,7 @@ def main(argv=None):
     for k in a.edge_cells:
         cell = 0.125 / k
         base = hopper_scene(cell=cell, discharge_time=a.discharge, field_frames=2)
-        for label, text in (("static", base), ("mu(I)", with_mu_of_i(base))):
+        for label, text in (("static", base), ("mu(I)", with_mu_of_i(base, MU_OF_I_BLOCK))):
             name = f"hopper_h{cell:.4f}_{'mui' if label != 'static' else 'mc'}"
             deck = out / f"{name}.inp"
             deck.write_text(text)
