@@ -22,7 +22,7 @@ module mpm_musl
        clear_records, &
        scatter_momentum_3d_packed
   use mpm_sort, only: sort_due, sort_blocks
-  use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block
+  use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block, wall_corner_dissipation
   use mpm_setup, only: mark_wall_nodes
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
   use output_effects, only: effects_t
@@ -144,6 +144,17 @@ contains
                     st%dt, st%wall_force(:, k), st%e_walls)
             end if
           end associate
+       end do
+       ! friction booked at nodes a later wall moved again (corners): on the velocity they keep
+       do k = 1, size(m%mpm%walls)
+          if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
+          if (m%mpm%walls(k)%surface > 0) then
+             call wall_corner_dissipation(st%wall_nodes(k), st%nd, st%g%mass_own, st%g%v_new, &
+                  st%rigid_v(:, m%mpm%walls(k)%surface), st%e_walls)
+          else
+             call wall_corner_dissipation(st%wall_nodes(k), st%nd, st%g%mass_own, st%g%v_new, &
+                  [0.0_dp, 0.0_dp, 0.0_dp], st%e_walls)
+          end if
        end do
        if (st%dom%on) call sum_increment_accounts(st, e_walls0, e_damping0)
        ! the work of the moving walls on the material, −F·v_w Δt (ALLWK; the grid and so the

@@ -32,10 +32,16 @@ module mpm_walls
   type, public :: wall_nodes_t
      integer, allocatable :: nodes(:)
      real(dp), allocatable :: normal(:, :)
+     !> This increment's friction record per node (the booking pass only; wall_corner_dissipation):
+     !> hit: a friction projection acted; dv(3, :): the tangential velocity friction removed;
+     !> v_after(3, :): the node's velocity right after this wall; booked: the dissipation booked.
+     logical, allocatable :: hit(:)
+     real(dp), allocatable :: dv(:, :), v_after(:, :), booked(:)
   end type wall_nodes_t
 
   public :: wall_find_nodes, wall_project, wall_contains, wall_distance, wall_slide_velocity, wall_rows_behind
   public :: surface_find_nodes, surface_wall_project, surface_node_velocity, surface_guard_block
+  public :: wall_corner_dissipation
 
   !> A node within this fraction of the cell from a wall is on it. Scene coordinates come with
   !> ~9 digits, and a cell written with 6 (0.0357143 for 0.125/3.5) put the hopper's axis node
@@ -144,7 +150,7 @@ contains
   !> normal velocity a wall removes is the reaction to the stress of a resting body, not a loss.
   subroutine wall_project(w, wn, ndim, mass, active, v, dt, force, dissipated)
     type(mpm_wall_t), intent(in) :: w
-    type(wall_nodes_t), intent(in) :: wn
+    type(wall_nodes_t), intent(inout) :: wn
     integer, intent(in) :: ndim
     real(dp), intent(in) :: mass(:)
     logical, intent(in) :: active(:)
@@ -159,6 +165,7 @@ contains
     scale = 1
 
     n = w%normal
+    if (present(dissipated)) call friction_record_reset(wn)
     do k = 1, size(wn%nodes)
        i = wn%nodes(k)
        if (.not. active(i)) cycle
@@ -172,8 +179,11 @@ contains
           call coulomb_slide(w%friction, vi, vn, n, vnew, tn, scale)
        end if
        if (present(force)) force = force - mass(i) * (vnew - vi) / dt
-       if (present(dissipated) .and. w%kind /= wall_symmetry) dissipated = dissipated + mass(i) * &
-            tn * tn * scale * (1 - scale)
+       if (present(dissipated) .and. w%kind /= wall_symmetry) then
+          wn%booked(k) = mass(i) * tn * tn * scale * (1 - scale)
+          dissipated = dissipated + wn%booked(k)
+          call friction_record(wn, k, ndim, vi, vn, n, vnew)
+       end if
        v(:, i) = vnew(1:ndim)
     end do
   end subroutine wall_project
@@ -282,7 +292,7 @@ contains
   !> of friction on the relative slip, m (|v_t| − |v_t,new|) |v_t,new| per node (wall_project's
   !> rule: a node held at rest books nothing).
   subroutine surface_wall_project(wn, vw, mu, ndim, mass, active, v, dt, force, dissipated)
-    type(wall_nodes_t), intent(in) :: wn
+    type(wall_nodes_t), intent(inout) :: wn
     real(dp), intent(in) :: vw(3), mu
     integer, intent(in) :: ndim
     real(dp), intent(in) :: mass(:)
@@ -295,6 +305,7 @@ contains
     real(dp) :: vi(3), vnew(3), tn, scale
     logical :: hit
 
+    if (present(dissipated)) call friction_record_reset(wn)
     do k = 1, size(wn%nodes)
        i = wn%nodes(k)
        if (.not. active(i)) cycle
@@ -303,7 +314,12 @@ contains
        call surface_node_velocity(wn%normal(:, k), vw, mu, vi, vnew, tn, scale, hit)
        if (.not. hit) cycle
        if (present(force)) force = force - mass(i) * (vnew - vi) / dt
-       if (present(dissipated)) dissipated = dissipated + mass(i) * tn * tn * scale * (1 - scale)
+       if (present(dissipated)) then
+          wn%booked(k) = mass(i) * tn * tn * scale * (1 - scale)
+          dissipated = dissipated + wn%booked(k)
+          call friction_record(wn, k, ndim, vi - vw, dot_product(vi - vw, wn%normal(:, k)), wn%normal(:, k), &
+               vnew - vw)
+       end if
        v(:, i) = vnew(1:ndim)
     end do
   end subroutine surface_wall_project
@@ -333,4 +349,65 @@ contains
        n_guarded = n_guarded + 1
     end do
   end subroutine surface_guard_block
+
+  ! ------------------------------------------------------------------------------------------
+  ! Friction dissipation at nodes a later wall moves again (corners)
+  ! ------------------------------------------------------------------------------------------
+
+  !> Size the wall's friction record to its node list (a rigid surface's list changes every
+  !> increment) and clear the hits.
+  subroutine friction_record_reset(wn)
+    type(wall_nodes_t), intent(inout) :: wn
+    integer :: n
+
+    n = size(wn%nodes)
+    if (allocated(wn%hit)) then
+       if (size(wn%hit) /= n) deallocate (wn%hit, wn%dv, wn%v_after, wn%booked)
+    end if
+    if (.not. allocated(wn%hit)) allocate (wn%hit(n), wn%dv(3, n), wn%v_after(3, n), wn%booked(n))
+    wn%hit = .false.
+  end subroutine friction_record_reset
+
+  !> Node k of the wall was projected by friction: keep the tangential velocity (relative to the
+  !> wall) that friction took, vt − vt_new, and the node's velocity after this wall (relative
+  !> velocities for a moving wall: the slip is relative to it).
+  pure subroutine friction_record(wn, k, ndim, vi, vn, n, vnew)
+    type(wall_nodes_t), intent(inout) :: wn
+    integer, intent(in) :: k, ndim
+    real(dp), intent(in) :: vi(3), vn, n(3), vnew(3)
+
+    wn%hit(k) = .true.
+    wn%dv(:, k) = (vi - vn * n) - vnew
+    wn%v_after(:, k) = 0
+    wn%v_after(1:ndim, k) = vnew(1:ndim)
+  end subroutine friction_record
+
+  !> After all walls of an increment: a node that a later wall moved again (a corner of two
+  !> walls, a wall meeting a symmetry plane) does not slip with the velocity its friction was
+  !> booked for. Friction's work is its force, −m dv/Δt, on the velocity the node keeps, v:
+  !> m dv·v per increment (for a node no other wall touches v = vt_new and this is the booked
+  !> m (|vt| − |vt_new|) |vt_new|, left as it was, bit for bit). So for each node whose velocity
+  !> changed after this wall, the booked amount is replaced by m max(0, dv·v): in a corner the
+  !> floor's friction books a slip along the floor that the side wall then stops, and a body at
+  !> rest there raised ALLFD every increment (tests/stability corner). `vw`: the wall's velocity
+  !> (a rigid surface; 0 for a fixed wall), since the slip is relative to it.
+  subroutine wall_corner_dissipation(wn, ndim, mass, v, vw, dissipated)
+    type(wall_nodes_t), intent(in) :: wn
+    integer, intent(in) :: ndim
+    real(dp), intent(in) :: mass(:), v(:, :), vw(3)
+    real(dp), intent(inout) :: dissipated
+    integer :: k, i
+    real(dp) :: vrel(3)
+
+    if (.not. allocated(wn%hit)) return
+    do k = 1, size(wn%nodes)
+       if (.not. wn%hit(k)) cycle
+       i = wn%nodes(k)
+       vrel = 0
+       vrel(1:ndim) = v(:, i) - vw(1:ndim)
+       ! unchanged since this wall (exactly: a difference of 0 in every component)
+       if (all(abs(vrel(1:ndim) - wn%v_after(1:ndim, k)) <= 0)) cycle
+       dissipated = dissipated - wn%booked(k) + mass(i) * max(0.0_dp, dot_product(wn%dv(:, k), vrel))
+    end do
+  end subroutine wall_corner_dissipation
 end module mpm_walls

@@ -20,10 +20,11 @@ import h5py
 import numpy as np
 
 CASES = {}
-# Not fixed (docs/stability.md, "Known failures"): a block at rest in a wall corner (ALLKE ~ 1e-22 J)
-# books wall-friction dissipation at a steady rate: grid nodes slip on one wall (the next wall's
-# projection, or the particles' weights, undo it), so ALLFD and ETOTAL rise. Positions stay put.
-KNOWN_ALLFD = "ALLFD (wall friction) grows at rest from node slip the particles do not follow; not fixed"
+# Not fixed (docs/stability.md, "Known failures"): the corner block's settling under gravity applied
+# at once ends with ETOTAL above its start, without wall friction and without damping too (not a
+# friction defect: the friction booked at rest in the corner is fixed, checked by `corner`).
+KNOWN_SETTLING = ("energy created while the block settles under gravity applied at once (also with "
+                  "frictionless walls and no damping; ALLWK ends near 0 with PIC): not fixed")
 
 
 def case(fn):
@@ -296,7 +297,15 @@ def corner(args):
               f"({np.min(x[:, 0]):.3e}, {np.max(x[:, 0]):.6f}, {np.min(x[:, 1]):.3e})")
     ke = hist["ALLKE"]
     check(ke[-1] <= 0.01 * np.max(ke), f"corner: at rest (ALLKE {ke[-1]:.3e} J, peak {np.max(ke):.3e} J)")
-    energy_not_created("corner", hist, known=KNOWN_ALLFD)
+    # at rest nothing may be booked: wall friction at a corner node that the other wall holds
+    # booked a slip that never happened, every increment (ETOTAL rose linearly at rest)
+    rest = (ke <= 1e-6 * np.max(ke)) & (np.arange(len(ke)) > np.argmax(ke))
+    scale = max(np.max(np.abs(hist[c])) for c in ("ALLWK", "ALLIE", "ALLKE"))
+    drift = float(np.ptp(hist["ETOTAL"][rest])) / scale if rest.sum() >= 2 else float("nan")
+    check(rest.sum() >= 10 and drift <= 1e-3,
+          f"corner: ETOTAL constant at rest ({int(rest.sum())} rows with ALLKE <= 1e-6 of its peak; "
+          f"change {drift:.3e} of the largest energy <= 1e-3)")
+    energy_not_created("corner", hist, known=KNOWN_SETTLING)
 
 
 REPO = Path(__file__).resolve().parents[2]
