@@ -20,11 +20,12 @@ import h5py
 import numpy as np
 
 CASES = {}
-# Not fixed (docs/stability.md, "Known failures"): the corner block's settling under gravity applied
-# at once ends with ETOTAL above its start, without wall friction and without damping too (not a
-# friction defect: the friction booked at rest in the corner is fixed, checked by `corner`).
-KNOWN_SETTLING = ("energy created while the block settles under gravity applied at once (also with "
-                  "frictionless walls and no damping; ALLWK ends near 0 with PIC): not fixed")
+# Not fixed (docs/stability.md, "Known failures"): gravity applied in one increment at CFL 0.4 makes
+# the corner block's impact create energy (also with frictionless walls, no damping and PIC; none at
+# CFL <= 0.2 or with gravity ramped). Not a friction defect: the friction booked at rest in the
+# corner is fixed, and `corner` checks ETOTAL constant at rest.
+KNOWN_SETTLING = ("energy created in the impact of gravity applied at once at CFL 0.4 (none at CFL <= 0.2 "
+                  "or with gravity ramped; frictionless and PIC alike): not fixed")
 
 
 def case(fn):
