@@ -321,15 +321,24 @@ def capacity(tmp, a):
     def solver(name):
         return [a.bulkflow, str(scene), "--output", str(tmp / name), "--quiet"]
 
+    # each run's own end: waiting on them in turn would give the second the first's end when it
+    # finished earlier (both walls then read the same, and the capacity came out low)
+    errs = [tmp / f"cap{k}.stderr" for k in (1, 2)]
+    sinks = [err.open("w") for err in errs]
     t0 = time.perf_counter()
-    pair = [subprocess.Popen(solver(f"cap{k}"), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-            for k in (1, 2)]
-    walls = []
-    for proc in pair:
-        err = proc.communicate()[1]
-        walls.append(time.perf_counter() - t0)
+    pair = [subprocess.Popen(solver(f"cap{k}"), stdout=subprocess.DEVNULL, stderr=sink)
+            for k, sink in zip((1, 2), sinks)]
+    walls = [None, None]
+    while None in walls:
+        for k, proc in enumerate(pair):
+            if walls[k] is None and proc.poll() is not None:
+                walls[k] = time.perf_counter() - t0
+        time.sleep(0.05)
+    for sink in sinks:
+        sink.close()
+    for proc, err in zip(pair, errs):
         if proc.returncode != 0:
-            sys.exit(f"bench_mpm --capacity: a 1-rank run failed:\n{err[-2000:]}")
+            sys.exit(f"bench_mpm --capacity: a 1-rank run failed:\n{err.read_text()[-2000:]}")
     both = statistics.mean(walls)
     cmd = solver("capnp")
     if a.np > 1:
