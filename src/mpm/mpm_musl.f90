@@ -101,6 +101,7 @@ contains
     type(effects_t), intent(inout) :: fx
     integer :: ib, k, s, ilo, ihi
     real(dp) :: e_walls0, e_damping0
+    real(dp) :: vw(3)   ! a wall's velocity (a rigid surface's; 0 for a fixed wall)
     logical :: packed, sorted
 
     s = st%step
@@ -148,13 +149,9 @@ contains
        ! friction booked at nodes a later wall moved again (corners): on the velocity they keep
        do k = 1, size(m%mpm%walls)
           if (.not. m%mpm%walls(k)%active(s) .or. st%mirrored(k)) cycle
-          if (m%mpm%walls(k)%surface > 0) then
-             call wall_corner_dissipation(st%wall_nodes(k), st%nd, st%g%mass_own, st%g%v_new, &
-                  st%rigid_v(:, m%mpm%walls(k)%surface), st%e_walls)
-          else
-             call wall_corner_dissipation(st%wall_nodes(k), st%nd, st%g%mass_own, st%g%v_new, &
-                  [0.0_dp, 0.0_dp, 0.0_dp], st%e_walls)
-          end if
+          vw = 0
+          if (m%mpm%walls(k)%surface > 0) vw = st%rigid_v(:, m%mpm%walls(k)%surface)
+          call wall_corner_dissipation(st%wall_nodes(k), st%nd, st%g%mass_own, st%g%v_new, vw, st%e_walls)
        end do
        if (st%dom%on) call sum_increment_accounts(st, e_walls0, e_damping0)
        ! the work of the moving walls on the material, −F·v_w Δt (ALLWK; the grid and so the
