@@ -180,8 +180,7 @@ contains
        else if (vn < 0) then
           call coulomb_slide(w%friction, vi, vn, n, vnew, tn, scale)
        else if (.not. present(dissipated) .and. held_this_increment(wn, k)) then
-          v(:, i) = v(:, i) - vn * n(1:ndim)
-          cycle
+          vnew = vi - vn * n
        else
           cycle
        end if
