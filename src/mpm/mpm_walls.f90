@@ -319,9 +319,8 @@ contains
        vi(1:ndim) = v(:, i)
        call surface_node_velocity(wn%normal(:, k), vw, mu, vi, vnew, tn, scale, hit)
        if (.not. hit) then
-          if (.not. present(dissipated) .and. held_this_increment(wn, k)) &
-               v(:, i) = v(:, i) - dot_product(vi - vw, wn%normal(:, k)) * wn%normal(1:ndim, k)
-          cycle
+          if (present(dissipated) .or. .not. held_this_increment(wn, k)) cycle
+          vnew = vi - dot_product(vi - vw, wn%normal(:, k)) * wn%normal(:, k)
        end if
        if (present(force)) force = force - mass(i) * (vnew - vi) / dt
        if (present(dissipated)) then
