@@ -77,3 +77,29 @@ def test_read_stop_params(tmp_path):
     p = read_stop_params(inp)
     assert (p.nset, p.displacement, p.ke_fraction, p.hold, p.min_time, p.growth, p.step, p.period) == \
         ("ALLN", 0.002, 0.03, 0.06, 0.02, 0.1, 2, 0.8)
+
+
+def test_run_ended_by_distortion_is_undecided_not_arrest(tmp_path):
+    # a creeping run that a folded element ends at 0.3 s of a 1 s step, displacement still growing:
+    # the early end is the solver's error, not its ARREST rule, so the rows say UNDECIDED
+    t = np.linspace(0, 0.3, 61)
+    u = 4e-4 * t + 5e-3 * t ** 2
+    ke = 1e-4 * (1 + 10 * t ** 2)
+    path = _write(tmp_path / "h.csv", t, u, ke)
+    assert decide(path, P).outcome == ARREST               # read as the solver's early stop
+    d = decide(path, P, ended_by="element 60 tangled at total time 0.9297 s")
+    assert d.outcome == UNDECIDED and "element 60 tangled" in d.reason
+
+
+def test_distortion_end_reads_the_solver_error(tmp_path):
+    from bulkflow.arching.runner import distortion_end
+    t = np.linspace(0, 0.3, 61)
+    path = _write(tmp_path / "h.csv", t, 1e-3 * t, np.full_like(t, 1e-4))
+    err = ("bulkflow: error: a.inp: element 60 at total time  9.29744E-01: element tangled: a corner "
+           "Jacobian <= 0 (bow-tie or folded element) (increment too large, ...)\n")
+    assert distortion_end(err, path, 3) == "element 60 tangled at total time 0.9297 s"
+    assert distortion_end(err, path, 2) == ""               # not in the opening step: an error
+    assert distortion_end("bulkflow: error: a.inp:12: expected a number\n", path, 3) == ""
+    with open(path, "a") as f:                              # a row cut short by the abort
+        f.write("1.3,3,0.3")
+    assert distortion_end(err, path, 3) == ""

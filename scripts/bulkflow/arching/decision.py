@@ -13,8 +13,11 @@ same rules and the parameters written in the scene:
               × its peak in the step for HOLD, or UMAX grew by ≤ GROWTH × limit over HOLD; a run
               that ended before its step period with UMAX below the limit was stopped by the
               solver's ARREST rule (evaluated every 10 increments, finer than the history rows);
-* UNDECIDED — neither, by the end of the step (slow creep): counted as flow by the search
-              (the material is not at rest), and reported as such.
+* UNDECIDED — neither, by the end of the step (slow creep), or neither by the time an element
+              distortion ended the run after the opening (`ended_by`: the solver's message; the
+              corner element at the wall folds in a creeping flow near the threshold on fine
+              meshes, README "Distortion after the opening"): counted as flow by the search (the
+              material is not at rest), and reported as such.
 """
 from __future__ import annotations
 
@@ -100,8 +103,9 @@ def read_stop_params(scene_path) -> StopParams:
     return params
 
 
-def decide(history_path, params: StopParams) -> Decision:
-    """Outcome of the step of `params` from the history rows."""
+def decide(history_path, params: StopParams, ended_by: str = "") -> Decision:
+    """Outcome of the step of `params` from the history rows. `ended_by`: the solver's error when an
+    element distortion ended the run in that step; then an early end is not the ARREST rule's."""
     h = read_history(history_path)
     col = f"UMAX_{params.nset}"
     if col not in h:
@@ -137,6 +141,8 @@ def decide(history_path, params: StopParams) -> Decision:
                 since = None
     if t_end >= params.min_time + params.hold and growth <= params.growth * params.displacement:
         return Decision(ARREST, "the displacement stopped growing over the hold time", **common)
+    if ended_by:
+        return Decision(UNDECIDED, f"neither rule was met when the run ended ({ended_by})", **common)
     if stopped_early:
         return Decision(ARREST, "the solver's stop condition ended the run (ARREST rule between history rows)",
                         **common)

@@ -7,6 +7,11 @@ The solver is `build/bin/bulkflow` of this checkout unless BULKFLOW_BIN (or `sol
 another. Open MPI's root/oversubscribe permissions are set in the child's environment. The
 decision is `bulkflow.arching.decision.decide` on the history CSV; the solver's own
 machine-readable stop line (stdout) is kept only as a cross-check in the record.
+
+A run that an element distortion ends after the plate opened (the solver's "element N ... tangled /
+inverted / collapsed" error, exit status 2) is decided from the rows it wrote, as UNDECIDED unless
+FLOW or ARREST was already reached (README "Distortion after the opening"); any other solver
+failure, and a distortion before the opening, raises.
 """
 from __future__ import annotations
 
@@ -55,12 +60,30 @@ class RunRecord:
     decision: dict = field(default_factory=dict)
     solver_line: str = ""
     base: str = ""
+    ended_by: str = ""                #: the solver's distortion error that ended the run, if one did
+
 
     def as_dict(self) -> dict:
         return asdict(self)
 
 
 _DONE = re.compile(r"bulkflow: done, (\d+) increments")
+_DISTORTION = re.compile(r"element (\d+) at total time\s+([-+.\dEe]+): element (tangled|inverted|collapsed)")
+
+
+def distortion_end(stderr: str, history: Path, step: int) -> str:
+    """The solver's element-distortion error as one short phrase, if it ended the run in `step`
+    (the history's last row is in that step); "" otherwise."""
+    m = _DISTORTION.search(stderr)
+    if not m or not history.exists():
+        return ""
+    lines = [ln for ln in history.read_text().splitlines() if ln.strip()]
+    # on several ranks the abort can cut rank 0's last row short: then the rows cannot be decided
+    if len(lines) < 2 or len(lines[-1].split(",")) != len(lines[0].split(",")):
+        return ""
+    if int(float(lines[-1].split(",")[1])) != step:
+        return ""
+    return f"element {m.group(1)} {m.group(3)} at total time {float(m.group(2)):.4f} s"
 
 
 def run_timed(cmd: list[str], log: Path) -> tuple[subprocess.CompletedProcess, float, float]:
@@ -74,6 +97,12 @@ def run_timed(cmd: list[str], log: Path) -> tuple[subprocess.CompletedProcess, f
     cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
     log.write_text(proc.stdout + proc.stderr)
     return proc, wall, cpu
+
+
+def _last_increment(history: Path) -> int:
+    """The increment of the history's last row (a run that ended without its "done" line)."""
+    lines = [ln for ln in history.read_text().splitlines() if ln.strip()] if history.exists() else []
+    return int(float(lines[-1].split(",")[3])) if len(lines) > 1 else 0
 
 
 def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = None, name: str | None = None,
@@ -90,16 +119,20 @@ def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = No
         mpirun = shutil.which("mpirun") or "mpirun"
         cmd = [mpirun, "-np", str(np)] + cmd
     proc, wall, cpu = run_timed(cmd, workdir / f"{name}.log")
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed with status {proc.returncode}:\n{proc.stderr[-2000:]}")
     params = read_stop_params(inp)
-    d = decide(f"{base}_history.csv", params)
+    ended_by = ""
+    if proc.returncode != 0:
+        ended_by = distortion_end(proc.stderr, Path(f"{base}_history.csv"), params.step)
+        if not ended_by:
+            raise RuntimeError(f"{' '.join(cmd)} failed with status {proc.returncode}:\n{proc.stderr[-2000:]}")
+    d = decide(f"{base}_history.csv", params, ended_by)
     line = next((ln for ln in proc.stdout.splitlines() if "stop condition: result=" in ln), "")
     m = _DONE.search(proc.stdout)
     rec = RunRecord(outlet_width=scene.outlet_width, n_arc=scene.n_arc, n_elements=scene.n_elements(),
                     outcome=d.outcome, flows=d.outcome in (FLOW, UNDECIDED), wall=wall,
-                    increments=int(m.group(1)) if m else 0, decision=d.as_dict(), solver_line=line,
-                    base=str(base), cpu=cpu)
+                    increments=int(m.group(1)) if m else _last_increment(Path(f"{base}_history.csv")),
+                    decision=d.as_dict(), solver_line=line,
+                    base=str(base), cpu=cpu, ended_by=ended_by)
     rec.element_steps = rec.increments * rec.n_elements
     if not keep:
         for suffix in (".h5", ".xmf"):
