@@ -25,7 +25,7 @@ from .hopper_run import DEFAULT_EXE, cached_run
 def run_bin(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, label="", **scene):
     """Write, run and reduce one bin scene (`scene`: bin_scene() keywords). Returns a dict: base,
     wall [s], particles (initial), n_out, n_left, mass_error (max |MASS_ERROR| / M0), t_open,
-    t_ss [s after opening, nan: not reached], mdr_model (per metre of the model), mdr_bin (the whole
+    t_ss [s after opening, None: not reached], t_first_change (discharge_figures), mdr_model (per metre of the model), mdr_bin (the whole
     bin per metre of depth: twice a half model's), the 0.5 s window ends and rates, the geometry
     and the scene keywords."""
     text = bin_scene(**scene)
@@ -43,15 +43,24 @@ def reduce_run(base, stdout, scene):
     hist = np.genfromtxt(base + "_history.csv", delimiter=",", names=True)
     m = re.search(r"particles (\d+) \((\d+) in, (\d+) out\)", stdout)
     n_left, n_out = int(m.group(1)), int(m.group(3))
-    t_open = opening_time(hist)
-    t_ss, ends, rates = steady_time(hist["time"], hist["MASS_OUT"], t_open)
-    mdr = steady_rate(hist["time"], hist["MASS_OUT"], t_open, t_ss)
     kw = {k: scene[k] for k in ("case", "cell", "edge_cells", "outlet", "width", "fill") if k in scene}
     geo = bin_geometry(**kw)
-    factor = 2.0 if geo["half"] else 1.0
     return dict(base=base, particles=int(hist["particles"][0]), n_out=n_out, n_left=n_left,
-                mass_error=float(np.abs(hist["MASS_ERROR"]).max() / hist["MASS"][0]), t_open=t_open,
-                t_ss=t_ss if math.isfinite(t_ss) else None, mdr_model=mdr, mdr_bin=factor * mdr,
-                window_ends=ends.tolist(), window_rates=(factor * rates).tolist(),
+                mass_error=float(np.abs(hist["MASS_ERROR"]).max() / hist["MASS"][0]),
                 psteps=int(re.search(r"throughput (\d+) particle-steps", stdout).group(1)),
-                geometry=geo, scene=scene)
+                geometry=geo, scene=scene, **discharge_figures(hist, 2.0 if geo["half"] else 1.0))
+
+
+def discharge_figures(hist, factor):
+    """t_open, T_ss (the end of the steady discharge: first fall > 10 % between 0.5 s windows,
+    bin_analysis.steady_time falls_only), t_first_change (the first change of either sign, the rule
+    of the runs before 2026-12-07; for a drifting rate the two differ), the MDR up to T_ss (model and
+    whole bin: `factor` 2 for a half model) and the windows, from a run's history columns."""
+    t, mass = hist["time"], hist["MASS_OUT"]
+    t_open = opening_time(hist)
+    t_ss, ends, rates = steady_time(t, mass, t_open, falls_only=True)
+    t_any, _, _ = steady_time(t, mass, t_open)
+    mdr = steady_rate(t, mass, t_open, t_ss)
+    return dict(t_open=t_open, t_ss=t_ss if math.isfinite(t_ss) else None,
+                t_first_change=t_any if math.isfinite(t_any) else None, mdr_model=mdr, mdr_bin=factor * mdr,
+                window_ends=ends.tolist(), window_rates=(factor * rates).tolist())

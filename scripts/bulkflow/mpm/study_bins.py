@@ -6,7 +6,8 @@ and DS (phi 46 -> 34 deg, psi 15 -> 0 over eps_cv = ln(eta_i/eta_cv)), Table 5.3
 and eccentric x NDNS and DS (bin_scene.py, 2D plane strain, per metre of depth), and with
 `--variants` the eccentric NDNS bin with a 34 deg right wall and the NDNS bins at rho_i = 1600.
 Figures (bin_analysis.py has the definitions; docs/bins.md discusses them):
-- table: T_ss (first > 10 % jump of the 0.5 s instantaneous MDR, §5.5.2) and the MDR (regression
+- table: T_ss (first > 10 % fall of the 0.5 s instantaneous MDR, §5.5.2: the onset of the plateau;
+  the first change of either sign beside it) and the MDR (regression
   of the discharged mass up to T_ss) of the whole bin per metre of depth, Beverloo's slot MDR per
   metre (rho_i, C = 0.64 and 0.58, k = 1.5, d = 0.71 mm: theory/beverloo.py) and the ratio, the
   particle balance and the wall time of each run -> bins_table.csv/.json;
@@ -63,7 +64,7 @@ def beverloo_per_metre(rho, C, outlet=OUTLET):
 
 
 def _runs(a):
-    from .bin_run import run_bin
+    from .bin_run import discharge_figures, run_bin
     todo = [(c, s, {}, "") for c, s in CASES]
     if a.cases:
         todo = []
@@ -81,6 +82,10 @@ def _runs(a):
                      pic_time=a.pic_time)
         scene.update(kw)
         r = run_bin(a.bulkflow, a.runs, reuse=not a.no_reuse, **scene)
+        # the figures from the history, not the cached record: runs made before the T_ss rule read
+        # only falls (2026-12-07) keep their old t_ss in their .json
+        hist = np.genfromtxt(r["base"] + "_history.csv", delimiter=",", names=True)
+        r.update(discharge_figures(hist, 2.0 if r["geometry"]["half"] else 1.0))
         r["label"] = f"{case} {sand}" + (f", {lab}" if lab else "")
         print(f"  {r['label']}: {r['particles']} particles, wall {r['wall']:.0f} s", flush=True)
         rows.append(r)
@@ -146,20 +151,21 @@ def run(a):
         rho = r["scene"].get("density", RHO_I)
         b64 = beverloo_per_metre(rho, 0.64)
         table.append(dict(bin=r["label"], cell_mm=1e3 * r["geometry"]["cell"], particles=r["particles"],
-                          wall_s=round(r["wall"], 1), t_ss_s=r["t_ss"], mdr_kg_s_m=r["mdr_bin"],
+                          wall_s=round(r["wall"], 1), t_ss_s=r["t_ss"], t_first_change_s=r["t_first_change"],
+                          mdr_kg_s_m=r["mdr_bin"],
                           beverloo_064=b64, mdr_over_beverloo_064=r["mdr_bin"] / b64,
                           mdr_last_window=r["window_rates"][-1] if r["window_rates"] else float("nan"),
                           n_out=r["n_out"], n_left=r["n_left"], mass_error_rel=r["mass_error"]))
-    print(f"\n{'bin':<34} {'cell mm':>7} {'particles':>9} {'wall s':>7} {'T_ss s':>7} {'MDR kg/s/m':>10} "
-          f"{'Bev.0.64':>8} {'MDR/Bev':>7} {'last 0.5s':>9}  balance")
+    print(f"\n{'bin':<34} {'cell mm':>7} {'particles':>9} {'wall s':>7} {'T_ss s':>7} {'1st chg':>7} "
+          f"{'MDR kg/s/m':>10} {'Bev.0.64':>8} {'MDR/Bev':>7} {'last 0.5s':>9}  balance")
     for t in table:
-        tss = f"{t['t_ss_s']:7.2f}" if t["t_ss_s"] is not None else "    n/r"
-        print(f"{t['bin']:<34} {t['cell_mm']:7.3f} {t['particles']:9d} {t['wall_s']:7.1f} {tss} "
+        tss, chg = (f"{v:7.2f}" if v is not None else "    n/r" for v in (t["t_ss_s"], t["t_first_change_s"]))
+        print(f"{t['bin']:<34} {t['cell_mm']:7.3f} {t['particles']:9d} {t['wall_s']:7.1f} {tss} {chg} "
               f"{t['mdr_kg_s_m']:10.3f} {t['beverloo_064']:8.3f} {t['mdr_over_beverloo_064']:7.3f} "
               f"{t['mdr_last_window']:9.3f}  "
               f"{t['particles']} = {t['n_out']} out + {t['n_left']} left, |dM|/M0 {t['mass_error_rel']:.1e}")
-    print(f"MDR: whole bin per metre of depth (2D plane strain); T_ss: s after opening, n/r = no > 10 % jump "
-          f"before the run ended (a T_ss of a bin whose MDR is a small fraction of Beverloo's marks noise of a "
+    print(f"MDR: whole bin per metre of depth (2D plane strain); T_ss: s after opening, n/r = no > 10 % fall "
+          f"before the run ended; 1st chg: the first > 10 % change of either sign (a rising rate's drift) (a T_ss of a bin whose MDR is a small fraction of Beverloo's marks noise of a "
           f"nearly stopped outflow, not the end of a steady discharge); last 0.5s: MDR of the last window; Beverloo slot per metre at rho_i, k = 1.5, d = 0.71 mm: C = 0.64 "
           f"{bev[0.64]:.3f}, C = 0.58 {bev[0.58]:.3f} kg/s/m")
     for r in rows:
@@ -197,7 +203,8 @@ def _write(out, rows, table, bev):
             for p in r["velocity"]:
                 for x, v in zip(p["x"], p["v"]):
                     w.writerow([r["label"], p["height"], f"{x:.6g}", f"{v:.6g}", p["frames"]])
-    keep = ("label", "base", "wall", "particles", "n_out", "n_left", "mass_error", "t_open", "t_ss", "mdr_bin",
+    keep = ("label", "base", "wall", "particles", "n_out", "n_left", "mass_error", "t_open", "t_ss", "t_first_change",
+            "mdr_bin",
             "window_ends", "window_rates", "geometry", "scene", "surfaces", "velocity", "psteps")
     with open(f"{out}/bins_table.json", "w") as f:
         json.dump(dict(table=table, beverloo=bev, runs=[{k: r[k] for k in keep} for r in rows]), f, indent=1,
