@@ -41,16 +41,19 @@ def test_steady_time_ignores_changes_below_ten_percent_and_reports_nan_without_a
     assert math.isnan(BA.steady_time(t, m, 0.3)[0])
 
 
-def test_falls_only_passes_a_rising_drift_and_stops_at_the_plateau():
-    # a rate rising by 12 % at 2.0 s after opening (a drift), then the outflow stops at 4.0 s
+def test_plateau_rule_passes_a_rising_drift_and_a_recovered_dip_and_stops_at_the_plateau():
+    # a rate that dips 15 % at 1.5 s after opening and recovers, rises 12 % at 2.5 s (a drift),
+    # then the outflow stops at 4.0 s
     t = np.arange(0.0, 7.0 + 1e-9, 0.01)
     s = np.clip(t - 0.3, 0.0, None)
-    rate = np.where(s < 2.0, 5.0, np.where(s < 4.0, 5.6, 0.2))
+    rate = np.select([s < 1.5, s < 2.0, s < 2.5, s < 4.0], [5.0, 4.25, 5.0, 5.6], 0.2)
     m = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(s))])
-    assert BA.steady_time(t, m, 0.3)[0] == pytest.approx(2.0)                    # either sign: the rise
-    assert BA.steady_time(t, m, 0.3, falls_only=True)[0] == pytest.approx(4.0)   # the plateau's onset
-    t, m = _history(rate_after=5.6)                                              # rises only: no end
-    assert math.isnan(BA.steady_time(t, m, 0.3, falls_only=True)[0])
+    assert BA.steady_time(t, m, 0.3)[0] == pytest.approx(1.5)                  # either sign: the dip
+    assert BA.steady_time(t, m, 0.3, plateau=True)[0] == pytest.approx(4.0)    # the plateau's onset
+    t, m = _history(rate_after=5.6)                                            # rises only: no end
+    assert math.isnan(BA.steady_time(t, m, 0.3, plateau=True)[0])
+    t, m = _history()                                                          # a plain stop
+    assert BA.steady_time(t, m, 0.3, plateau=True)[0] == pytest.approx(4.0)
 
 
 def test_opening_time_from_step_columns():

@@ -10,10 +10,12 @@ two readers of a run's particle frames. The definitions (docs/bins.md, "Outputs"
   (D = 0.5 s, s = `skip` = D: the first window starts 0.5 s after opening, past the start-up);
   the first j >= 2 with |r_j / r_(j-1) - 1| > 10 % marks the sudden change; T_ss = t_(j-1) - t_open,
   the time just before it. No such jump before the run ends: T_ss is not reached (nan).
-  `falls_only`: only a fall r_j / r_(j-1) - 1 < -10 % counts. The thesis's sudden change is the
-  one "at the beginning of the plateau region" of M(t), where the outflow stops; a rate that
-  drifts upwards by 10 % between two windows (the eccentric bins, docs/bins.md) is not the end of
-  a steady discharge. The bins study uses it; the accuracy families keep either sign.
+  `plateau`: only the fall that begins the plateau counts: r_j / r_(j-1) - 1 < -10 % and no later
+  window regains 90 % of r_(j-1). The thesis's sudden change is the one "observed at the beginning
+  of the plateau region" of M(t), where the outflow stops; a rate that drifts upwards by 10 %
+  between two windows (the eccentric bins, docs/bins.md), or dips by 10 % and recovers (the DS
+  bins), has not ended its discharge. A fall in the record's last window has no later window to
+  confirm it and is taken. The bins study uses it; the accuracy families keep either sign.
 - MDR: slope of the least-squares line through M(t) over t_open + skip .. t_open + T_ss.
 - free surface: the highest particle centre above the bottom (y >= 0) in columns of width dx; an
   empty column is nan (floor bare). Shape of a profile: its chord from the lowest to the highest
@@ -56,15 +58,18 @@ def window_rates(t, mass, t_open, interval=T_SS_INTERVAL, skip=T_SS_INTERVAL):
     return ends, (m_end - m_start) / interval
 
 
-def steady_time(t, mass, t_open, interval=T_SS_INTERVAL, skip=T_SS_INTERVAL, jump=T_SS_JUMP, falls_only=False):
+def steady_time(t, mass, t_open, interval=T_SS_INTERVAL, skip=T_SS_INTERVAL, jump=T_SS_JUMP, plateau=False):
     """T_ss (s after opening) by the module's rule, and the window ends and rates it used.
-    nan when no jump (no fall, with `falls_only`) occurs before the record ends."""
+    nan when no jump (with `plateau`: no fall that the rate does not recover from) occurs before
+    the record ends."""
     ends, rates = window_rates(t, mass, t_open, interval, skip)
     for j in range(1, len(rates)):
         if rates[j - 1] <= 0:
             continue
         change = rates[j] / rates[j - 1] - 1.0
-        if (change < -jump) if falls_only else (abs(change) > jump):
+        if not plateau and abs(change) > jump:
+            return float(ends[j - 1]), ends, rates
+        if plateau and change < -jump and not np.any(rates[j + 1:] >= (1.0 - jump) * rates[j - 1]):
             return float(ends[j - 1]), ends, rates
     return float("nan"), ends, rates
 

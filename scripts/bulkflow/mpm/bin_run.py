@@ -52,13 +52,13 @@ def reduce_run(base, stdout, scene):
 
 
 def discharge_figures(hist, factor):
-    """t_open, T_ss (the end of the steady discharge: first fall > 10 % between 0.5 s windows,
-    bin_analysis.steady_time falls_only), t_first_change (the first change of either sign, the rule
+    """t_open, T_ss (the end of the steady discharge: the fall > 10 % between 0.5 s windows that
+    begins the plateau, bin_analysis.steady_time `plateau`), t_first_change (the first change of either sign, the rule
     of the runs before 2026-12-07; for a drifting rate the two differ), the MDR up to T_ss (model and
     whole bin: `factor` 2 for a half model) and the windows, from a run's history columns."""
     t, mass = hist["time"], hist["MASS_OUT"]
     t_open = opening_time(hist)
-    t_ss, ends, rates = steady_time(t, mass, t_open, falls_only=True)
+    t_ss, ends, rates = steady_time(t, mass, t_open, plateau=True)
     t_any, _, _ = steady_time(t, mass, t_open)
     mdr = steady_rate(t, mass, t_open, t_ss)
     return dict(t_open=t_open, t_ss=t_ss if math.isfinite(t_ss) else None,

@@ -6,7 +6,7 @@ and DS (phi 46 -> 34 deg, psi 15 -> 0 over eps_cv = ln(eta_i/eta_cv)), Table 5.3
 and eccentric x NDNS and DS (bin_scene.py, 2D plane strain, per metre of depth), and with
 `--variants` the eccentric NDNS bin with a 34 deg right wall and the NDNS bins at rho_i = 1600.
 Figures (bin_analysis.py has the definitions; docs/bins.md discusses them):
-- table: T_ss (first > 10 % fall of the 0.5 s instantaneous MDR, §5.5.2: the onset of the plateau;
+- table: T_ss (the > 10 % fall of the 0.5 s instantaneous MDR that begins the plateau, §5.5.2;
   the first change of either sign beside it) and the MDR (regression
   of the discharged mass up to T_ss) of the whole bin per metre of depth, Beverloo's slot MDR per
   metre (rho_i, C = 0.64 and 0.58, k = 1.5, d = 0.71 mm: theory/beverloo.py) and the ratio, the
@@ -164,7 +164,7 @@ def run(a):
               f"{t['mdr_kg_s_m']:10.3f} {t['beverloo_064']:8.3f} {t['mdr_over_beverloo_064']:7.3f} "
               f"{t['mdr_last_window']:9.3f}  "
               f"{t['particles']} = {t['n_out']} out + {t['n_left']} left, |dM|/M0 {t['mass_error_rel']:.1e}")
-    print(f"MDR: whole bin per metre of depth (2D plane strain); T_ss: s after opening, n/r = no > 10 % fall "
+    print(f"MDR: whole bin per metre of depth (2D plane strain); T_ss: s after opening, n/r = no > 10 % fall that the rate does not recover from "
           f"before the run ended; 1st chg: the first > 10 % change of either sign (a rising rate's drift) (a T_ss of a bin whose MDR is a small fraction of Beverloo's marks noise of a "
           f"nearly stopped outflow, not the end of a steady discharge); last 0.5s: MDR of the last window; Beverloo slot per metre at rho_i, k = 1.5, d = 0.71 mm: C = 0.64 "
           f"{bev[0.64]:.3f}, C = 0.58 {bev[0.58]:.3f} kg/s/m")
