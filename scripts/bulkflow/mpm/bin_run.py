@@ -25,8 +25,8 @@ from .hopper_run import DEFAULT_EXE, cached_run
 def run_bin(exe=DEFAULT_EXE, out_dir="out/mpm_study/runs", reuse=True, label="", **scene):
     """Write, run and reduce one bin scene (`scene`: bin_scene() keywords). Returns a dict: base,
     wall [s], particles (initial), n_out, n_left, mass_error (max |MASS_ERROR| / M0), t_open,
-    t_ss [s after opening, None: not reached], t_first_change (discharge_figures), mdr_model (per metre of the model), mdr_bin (the whole
-    bin per metre of depth: twice a half model's), the 0.5 s window ends and rates, the geometry
+    t_ss [s after opening, None: not reached], t_first_change (discharge_figures), mdr_model (per
+    metre of the model), mdr_bin (the whole bin per metre of depth: twice a half model's), the 0.5 s window ends and rates, the geometry
     and the scene keywords."""
     text = bin_scene(**scene)
 
@@ -53,8 +53,8 @@ def reduce_run(base, stdout, scene):
 
 def discharge_figures(hist, factor):
     """t_open, T_ss (the end of the steady discharge: the fall > 10 % between 0.5 s windows that
-    begins the plateau, bin_analysis.steady_time `plateau`), t_first_change (the first change of either sign, the rule
-    of the runs before 2026-12-07; for a drifting rate the two differ), the MDR up to T_ss (model and
+    begins the plateau, bin_analysis.steady_time `plateau`), t_first_change (the first change of
+    either sign, the rule of the runs before 2026-12-07; for a drifting rate the two differ), the MDR up to T_ss (model and
     whole bin: `factor` 2 for a half model) and the windows, from a run's history columns."""
     t, mass = hist["time"], hist["MASS_OUT"]
     t_open = opening_time(hist)

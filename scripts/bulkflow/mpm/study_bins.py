@@ -82,8 +82,8 @@ def _runs(a):
                      pic_time=a.pic_time)
         scene.update(kw)
         r = run_bin(a.bulkflow, a.runs, reuse=not a.no_reuse, **scene)
-        # the figures from the history, not the cached record: runs made before the T_ss rule read
-        # only falls (2026-12-07) keep their old t_ss in their .json
+        # the figures from the history, not the cached record: runs made before the plateau rule
+        # for T_ss (2026-12-07) keep the old rule's t_ss in their .json
         hist = np.genfromtxt(r["base"] + "_history.csv", delimiter=",", names=True)
         r.update(discharge_figures(hist, 2.0 if r["geometry"]["half"] else 1.0))
         r["label"] = f"{case} {sand}" + (f", {lab}" if lab else "")
@@ -164,8 +164,9 @@ def run(a):
               f"{t['mdr_kg_s_m']:10.3f} {t['beverloo_064']:8.3f} {t['mdr_over_beverloo_064']:7.3f} "
               f"{t['mdr_last_window']:9.3f}  "
               f"{t['particles']} = {t['n_out']} out + {t['n_left']} left, |dM|/M0 {t['mass_error_rel']:.1e}")
-    print(f"MDR: whole bin per metre of depth (2D plane strain); T_ss: s after opening, n/r = no > 10 % fall that the rate does not recover from "
-          f"before the run ended; 1st chg: the first > 10 % change of either sign (a rising rate's drift) (a T_ss of a bin whose MDR is a small fraction of Beverloo's marks noise of a "
+    print(f"MDR: whole bin per metre of depth (2D plane strain); T_ss: s after opening, n/r = no > 10 % fall "
+          f"that the rate does not recover from before the run ended; 1st chg: the first > 10 % change of either "
+          f"sign (a drift or a dip) (a T_ss of a bin whose MDR is a small fraction of Beverloo's marks noise of a "
           f"nearly stopped outflow, not the end of a steady discharge); last 0.5s: MDR of the last window; Beverloo slot per metre at rho_i, k = 1.5, d = 0.71 mm: C = 0.64 "
           f"{bev[0.64]:.3f}, C = 0.58 {bev[0.58]:.3f} kg/s/m")
     for r in rows:
@@ -203,9 +204,8 @@ def _write(out, rows, table, bev):
             for p in r["velocity"]:
                 for x, v in zip(p["x"], p["v"]):
                     w.writerow([r["label"], p["height"], f"{x:.6g}", f"{v:.6g}", p["frames"]])
-    keep = ("label", "base", "wall", "particles", "n_out", "n_left", "mass_error", "t_open", "t_ss", "t_first_change",
-            "mdr_bin",
-            "window_ends", "window_rates", "geometry", "scene", "surfaces", "velocity", "psteps")
+    keep = ("label", "base", "wall", "particles", "n_out", "n_left", "mass_error", "t_open", "t_ss",
+            "t_first_change", "mdr_bin", "window_ends", "window_rates", "geometry", "scene", "surfaces", "velocity", "psteps")
     with open(f"{out}/bins_table.json", "w") as f:
         json.dump(dict(table=table, beverloo=bev, runs=[{k: r[k] for k in keep} for r in rows]), f, indent=1,
                   default=lambda o: None if isinstance(o, float) and math.isnan(o) else o)
