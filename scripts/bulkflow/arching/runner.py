@@ -75,15 +75,20 @@ def distortion_end(stderr: str, history: Path, step: int) -> str:
     """The solver's element-distortion error as one short phrase, if it ended the run in `step`
     (the history's last row is in that step); "" otherwise."""
     m = _DISTORTION.search(stderr)
-    if not m or not history.exists():
-        return ""
-    lines = [ln for ln in history.read_text().splitlines() if ln.strip()]
-    # on several ranks the abort can cut rank 0's last row short: then the rows cannot be decided
-    if len(lines) < 2 or len(lines[-1].split(",")) != len(lines[0].split(",")):
-        return ""
-    if int(float(lines[-1].split(",")[1])) != step:
+    row = _last_row(history) if m else []
+    # columns time, step, ...: the row must be whole and in the opening step
+    if not row or int(float(row[1])) != step:
         return ""
     return f"element {m.group(1)} {m.group(3)} at total time {float(m.group(2)):.4f} s"
+
+
+def _last_row(history: Path) -> list[str]:
+    """The fields of the history's last row; [] without a row, or when the row is cut short (on
+    several ranks an abort can end rank 0 mid-row: then the rows cannot be decided)."""
+    lines = [ln for ln in history.read_text().splitlines() if ln.strip()] if history.exists() else []
+    if len(lines) < 2 or len(lines[-1].split(",")) != len(lines[0].split(",")):
+        return []
+    return lines[-1].split(",")
 
 
 def run_timed(cmd: list[str], log: Path) -> tuple[subprocess.CompletedProcess, float, float]:
@@ -97,12 +102,6 @@ def run_timed(cmd: list[str], log: Path) -> tuple[subprocess.CompletedProcess, f
     cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
     log.write_text(proc.stdout + proc.stderr)
     return proc, wall, cpu
-
-
-def _last_increment(history: Path) -> int:
-    """The increment of the history's last row (a run that ended without its "done" line)."""
-    lines = [ln for ln in history.read_text().splitlines() if ln.strip()] if history.exists() else []
-    return int(float(lines[-1].split(",")[3])) if len(lines) > 1 else 0
 
 
 def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = None, name: str | None = None,
@@ -128,9 +127,10 @@ def run_scene(scene: ArchingScene, workdir, np: int = 2, solver: str | None = No
     d = decide(f"{base}_history.csv", params, ended_by)
     line = next((ln for ln in proc.stdout.splitlines() if "stop condition: result=" in ln), "")
     m = _DONE.search(proc.stdout)
+    last = [] if m else _last_row(Path(f"{base}_history.csv"))    # a run ended early: its last row's increment
     rec = RunRecord(outlet_width=scene.outlet_width, n_arc=scene.n_arc, n_elements=scene.n_elements(),
                     outcome=d.outcome, flows=d.outcome in (FLOW, UNDECIDED), wall=wall,
-                    increments=int(m.group(1)) if m else _last_increment(Path(f"{base}_history.csv")),
+                    increments=int(m.group(1)) if m else int(float((last or ["0"] * 4)[3])),
                     decision=d.as_dict(), solver_line=line,
                     base=str(base), cpu=cpu, ended_by=ended_by)
     rec.element_steps = rec.increments * rec.n_elements
