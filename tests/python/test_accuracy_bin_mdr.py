@@ -90,6 +90,14 @@ def test_measure_stops_at_the_end_of_steady_discharge(tmp_path):
     (["bin-mdr", "--inertial-friction", "55,0.3,1e-3"], "expected four numbers"),
     (["bin-mdr", "--inertial-friction", "95,0.3,1e-3,2650"], "(0, 89]"),
     (["k0-column", "--pic-time", "0.01"], "--pic-time applies to"),
+    (["wave-bar", "--edge-cells", "1,2,3"], "--edge-cells applies to"),
+    (["bin-mdr", "--edge-cells", "2,3"], "at least three distinct"),
+    (["bin-mdr", "--edge-cells", "2,3,3.5"], "whole numbers"),
+    (["hopper-mdr", "--edge-cells", "4.5,5.5,6"], "n + 1/2"),
+    (["bin-mdr", "--hopper-scene", "wall_friction=0"], "applies to hopper-mdr only"),
+    (["hopper-mdr", "--hopper-scene", "cell=0.1"], "expected KEY=VALUE"),
+    (["hopper-mdr", "--hopper-scene", "wall_friction"], "expected KEY=VALUE"),
+    (["hopper-mdr", "--hopper-scene", "wall_friction=steel"], "a number or true/false"),
 ])
 def test_command_line_refuses(argv, message, capsys):
     with pytest.raises(SystemExit):
@@ -99,3 +107,21 @@ def test_command_line_refuses(argv, message, capsys):
 
 def test_inertial_friction_block_reads_four_numbers():
     assert cli.inertial_friction_block("55.2, 0.279, 0.71e-3, 2650") == (55.2, 0.279, 0.71e-3, 2650.0)
+
+
+def test_edge_cells_list_reads_the_members():
+    assert cli.edge_cells_list("4,5,6", half=False) == [4, 5, 6]
+    assert cli.edge_cells_list("4.5, 5.5, 6.5", half=True) == [4.5, 5.5, 6.5]
+    assert isinstance(cli.edge_cells_list("4,x,6", half=False), str)
+
+
+def test_hopper_scene_keywords_reach_every_member(monkeypatch):
+    assert cli.hopper_scene_keywords(["wall_friction=0", "dilation=false"]) == {"wall_friction": 0.0,
+                                                                                 "dilation": False}
+    monkeypatch.setattr(hopper_mdr, "SCENE_EXTRA", {"wall_friction": 0.0})
+    member = hopper_mdr.members(True)[0]
+    frictionless = hopper_mdr.scene(member)
+    monkeypatch.setattr(hopper_mdr, "SCENE_EXTRA", {})
+    default = hopper_mdr.scene(member)
+    assert frictionless != default
+    assert "*MPM WALL, NAME=WALL, FRICTION=0.0000000" in frictionless

@@ -35,6 +35,14 @@ def main(argv=None) -> int:
                         help="hopper-mdr, bin-mdr: the regularised family, μ(I) in every member's Mohr-Coulomb "
                              "sand (docs/mu_of_i.md: φ2 [deg], I0, grain diameter d [m], grain density [kg/m3]); "
                              "default output folder out/accuracy/KIND-mu-i")
+    parser.add_argument("--edge-cells", default=None, metavar="LIST",
+                        help="hopper-mdr, bin-tss, bin-mdr: the members, comma-separated (hopper-mdr: the outlet "
+                             "half-width in cells, n + 1/2, cell 0.125/n m; the bins: k, cell b/(2k+1)) instead of "
+                             "the family's default or --quick list")
+    parser.add_argument("--hopper-scene", action="append", default=[], metavar="KEY=VALUE",
+                        help="hopper-mdr only, repeatable: a keyword of bulkflow.mpm.hopper_scene in every member "
+                             "(a number, or true/false), e.g. wall_friction=0 or psi_constant=0; default output "
+                             "folder out/accuracy/hopper-mdr-KEY-VALUE")
     parser.add_argument("--summarise-only", action="store_true",
                         help="no runs: the summary and outputs again from the measured rows of OUT/KIND.json")
     args = parser.parse_args(argv)
@@ -56,7 +64,23 @@ def main(argv=None) -> int:
         if args.pic_time < 0:
             parser.error("--pic-time must be >= 0")
         MPM_FLOW[args.kind].PIC_TIME = args.pic_time
+    if args.edge_cells is not None:
+        if args.kind not in MPM_FLOW:
+            parser.error(f"--edge-cells applies to {', '.join(MPM_FLOW)} only")
+        cells = edge_cells_list(args.edge_cells, half=args.kind == "hopper-mdr")
+        if isinstance(cells, str):
+            parser.error(f"--edge-cells {args.edge_cells!r}: {cells}")
+        MPM_FLOW[args.kind].EDGE_CELLS = MPM_FLOW[args.kind].QUICK_EDGE_CELLS = cells
     suffix = ""
+    if args.hopper_scene:
+        if args.kind != "hopper-mdr":
+            parser.error("--hopper-scene applies to hopper-mdr only")
+        extra = hopper_scene_keywords(args.hopper_scene)
+        if isinstance(extra, str):
+            parser.error(f"--hopper-scene: {extra}")
+        hopper_mdr.SCENE_EXTRA = extra
+        kind = dict(kind, title=f"{kind['title']}, with " + ", ".join(args.hopper_scene))
+        suffix += "".join(f"-{k}-{v:g}" if not isinstance(v, bool) else f"-{k}-{v}" for k, v in extra.items())
     if args.inertial_friction is not None:
         if args.kind not in REGULARISED:
             parser.error(f"--inertial-friction applies to {', '.join(REGULARISED)} only")
@@ -66,7 +90,7 @@ def main(argv=None) -> int:
         MPM_FLOW[args.kind].INERTIAL_FRICTION = block
         kind = dict(kind, title=f"{kind['title']}, with μ(I) (φ2 {block[0]:g}°, I0 {block[1]:g}, "
                                 f"d {block[2]:g} m, ρs {block[3]:g} kg/m³)")
-        suffix = "-mu-i"
+        suffix += "-mu-i"
     out = args.out or Path("out") / "accuracy" / f"{args.kind}{suffix}"
     print(f"{kind['name']}: {kind['title']}{' (quick)' if args.quick else ''}")
     if args.summarise_only:
@@ -100,6 +124,50 @@ def main(argv=None) -> int:
         print(f"also {e['what']}: {ref}")
     print(f"wrote {out / kind['name']}.csv, .png, .json, .md")
     return 0
+
+
+def edge_cells_list(text: str, half: bool):
+    """The members of --edge-cells (at least three, distinct), or what is wrong with the list (a str).
+    half: hopper-mdr's values n + 1/2 (the outlet edge mid-cell); else whole k ≥ 1 (the bins)."""
+    try:
+        vals = [float(v) for v in text.split(",")]
+    except ValueError:
+        return "expected comma-separated numbers"
+    if len(vals) < 3 or len(set(vals)) != len(vals):
+        return "expected at least three distinct members (an observed order needs three)"
+    if half:
+        if any(v < 1.5 or (v - 0.5) != int(v - 0.5) for v in vals):
+            return "hopper-mdr's members are n + 1/2 with n ≥ 1 (the outlet edge mid-cell): 1.5, 2.5, …"
+        return vals
+    if any(v < 1 or v != int(v) for v in vals):
+        return "the bins' members are whole numbers k ≥ 1 (cell b/(2k + 1))"
+    return [int(v) for v in vals]
+
+
+def hopper_scene_keywords(items):
+    """{keyword: value} from --hopper-scene KEY=VALUE items, or what is wrong (a str): each KEY must be a
+    keyword of hopper_scene that a family does not set itself, each VALUE a number or true/false."""
+    import inspect
+
+    from ..mpm.hopper_scene import hopper_scene
+
+    allowed = set(inspect.signature(hopper_scene).parameters) - {
+        "cell", "ppc", "shape", "field_frames", "discharge_frames", "pic_time", "title", "command"}
+    out = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or key not in allowed:
+            return f"{item!r}: expected KEY=VALUE with KEY one of {', '.join(sorted(allowed))}"
+        low = text.strip().lower()
+        if low in ("true", "false"):
+            out[key] = low == "true"
+            continue
+        try:
+            out[key] = float(text)
+        except ValueError:
+            return f"{item!r}: VALUE must be a number or true/false"
+    return out
 
 
 def inertial_friction_block(text: str):

@@ -32,6 +32,9 @@ QUICK = dict(height=1.0, fill_time=0.5, ramp=0.3, discharge_time=1.0)
 PIC_TIME = 0.0
 # bulkflow-accuracy --inertial-friction: (φ2 [deg], I0, d [m], ρs [kg/m3]) or None (static MC)
 INERTIAL_FRICTION = None
+# bulkflow-accuracy --hopper-scene KEY=VALUE: further hopper_scene keywords in every member (a
+# variant family: wall_friction=0, psi_constant=0, ...)
+SCENE_EXTRA: dict = {}
 
 
 def members(quick: bool) -> list[dict]:
@@ -47,6 +50,7 @@ def scene(member: dict) -> str:
     kw = dict(QUICK if member["quick_case"] else FULL)
     if PIC_TIME > 0:
         kw["pic_time"] = PIC_TIME
+    kw.update(SCENE_EXTRA)
     # 2 particle frames in the fill step, 6 in the discharge: the wall force averages the last 3
     text = scene_text(cell=member["cell"], ppc=2, shape="GIMP", field_frames=2, discharge_frames=6, **kw)
     if INERTIAL_FRICTION is not None:
