@@ -9,9 +9,9 @@ grain. Then f^(1/e) is linear in h (Beverloo's plot, with h on the axis instead 
 line gives both the limit M0 = f(0) and κ, the narrowing in cells. The model is an assumption
 about the leading error, checked in docs/accuracy.md ("The discharge rate against the cell: an
 outlet-narrowing model and its checks"): it predicted the eccentric bin's b/13 member from b/7-b/11
-to 0.3 %, but not the 1 m hopper's finer members (1.5-3 % low), and at a fixed cell the bins'
-Beverloo intercept is 1.5-2 cells against the concentric family's κ = 2.5. So M0 is an estimate
-that rests on the form, not a reference; bulkflow-accuracy does not use it.
+to 0.3 %, but not the 1 m hopper's finer members (1.5-3 % low) nor the concentric bin's b/15
+(3-4 % high), and at a fixed cell the bins' Beverloo intercept is 1.5-2 cells against the
+concentric family's κ = 2.5. So M0 is not a reference; bulkflow-accuracy does not use it.
 
 No solver and no files here; tests/python/test_accuracy_outlet_cell.py checks it against
 closed-form families.
