@@ -3,9 +3,9 @@
 Why this form. A continuum discharging through an outlet of width b has no length of its own but
 b, so its rate scales as b^e (e = 3/2 for a slot, Beverloo's exponent in plane flow). On the grid
 the wall condition of the floor (or of the hopper wall) is carried by nodes whose shape functions
-reach about a cell into the opening, so the sand flows as through an outlet narrowed by a length proportional to the cell,
-κ h: the role Beverloo's empty annulus k d plays for grains, with the cell in place of the
-grain. Then f^(1/e) is linear in h (Beverloo's plot, with h on the axis instead of b), and its
+reach about a cell into the opening, so the sand flows as through an outlet narrowed by a length
+proportional to the cell, κ h: the role Beverloo's empty annulus k d plays for grains, with the
+cell in place of the grain. Then f^(1/e) is linear in h (Beverloo's plot, with h on the axis instead of b), and its
 line gives both the limit M0 = f(0) and κ, the narrowing in cells. The model is an assumption
 about the leading error, checked in docs/accuracy.md ("The discharge rate against the cell: an
 outlet-narrowing model and its checks"): it predicted the eccentric bin's b/13 member from b/7-b/11
@@ -45,7 +45,7 @@ class OutletCellFit:
 
     def error(self, h: float) -> float:
         """The model's relative error of a member of cell h: 1 − f(h)/M0."""
-        return 1.0 - (1.0 - self.kappa * h / self.width) ** self.exponent
+        return 1.0 - self.rate(h) / self.limit
 
     def cell_for_error(self, target: float) -> float:
         """The largest cell whose model error is within `target` (0.01 for 1 %)."""
@@ -148,14 +148,14 @@ def describe(fit: OutletCellFit, quantity: str = "MDR", ratio: float | None = No
     return lines
 
 
-
 def main(argv=None) -> int:
     """python -m bulkflow.accuracy.outlet_cell --width B --across N1 N2 N3 ... --values F1 F2 F3 ...
     [--predict N ...]: the fit of members with N cells across an outlet B wide, and the model's rate
     at further members (a prediction to hold against a run)."""
     import argparse
 
-    p = argparse.ArgumentParser(prog="python -m bulkflow.accuracy.outlet_cell", description=" ".join(main.__doc__.split()))
+    p = argparse.ArgumentParser(prog="python -m bulkflow.accuracy.outlet_cell",
+                                description=" ".join(main.__doc__.split()))
     p.add_argument("--width", type=float, required=True, help="outlet width b (the unit of the cells)")
     p.add_argument("--across", type=float, nargs="+", required=True, help="each member's cells across the outlet, b/h")
     p.add_argument("--values", type=float, nargs="+", required=True, help="each member's rate")
