@@ -7,7 +7,8 @@
 !>   *MPM SIDE FRICTION, GAP=t, FRICTION=μw         2D, model data or in a step; carries over
 !>   *PARTICLES, MATERIAL=name [, PPC=n] [, TYPE=BOX|POLYGON] [, Z1=, Z2=] [, VX=, VY=, VZ=]
 !>                                                  data: BOX lo; hi  |  POLYGON x, y per line
-!>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, OP=DELETE]
+!>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, REACH=r] [, OPEN=START|END|BOTH]
+!>     [, OP=DELETE]
 !>                                                  data 2D: x0, y0, x1, y1 (material on the left)
 !>                                                  data 3D: px, py, pz, nx, ny, nz [; lo; hi]
 !>   *OUTFLOW, BELOW=y                              model data: particles below y leave
@@ -412,12 +413,12 @@ contains
     type(error_t), intent(inout) :: err
     type(mpm_wall_t) :: w
     type(mpm_wall_t), allocatable :: grown(:)
-    character(len=:), allocatable :: name, kind, op
+    character(len=:), allocatable :: name, kind, op, open_ends
     integer :: nd, k, n, found
     real(dp) :: t(3), length
 
     nd = mpm%ndim
-    call blk%check_params([character(len=8) :: 'NAME', 'TYPE', 'FRICTION', 'OP', 'REACH'], err)
+    call blk%check_params([character(len=8) :: 'NAME', 'TYPE', 'FRICTION', 'OP', 'REACH', 'OPEN'], err)
     if (.not. err%raised) call blk%get_string('NAME', name, err)
     if (.not. err%raised) call check_name(blk, 'wall', name, wall_name_length, err)
     if (.not. err%raised) call blk%get_string('OP', op, err, default='NEW', choices=[character(len=6) :: &
@@ -435,8 +436,9 @@ contains
           call blk%fail('*MPM WALL, OP=DELETE: wall ' // name // ' is not defined; expected the NAME of an ' // &
                'earlier *MPM WALL', err)
        else if (blk%has_param('TYPE') .or. blk%has_param('FRICTION') .or. blk%has_param('REACH') .or. &
-            blk%n_lines > 0) then
-          call blk%fail('*MPM WALL, OP=DELETE takes only NAME; expected no TYPE, FRICTION, REACH or data lines', err)
+            blk%has_param('OPEN') .or. blk%n_lines > 0) then
+          call blk%fail('*MPM WALL, OP=DELETE takes only NAME; expected no TYPE, FRICTION, REACH, OPEN or data ' // &
+               'lines', err)
        else
           mpm%walls(found)%active(s:) = .false.
        end if
@@ -452,7 +454,15 @@ contains
     call blk%get_string('TYPE', kind, err, default='FRICTION', choices=[character(len=8) :: 'FRICTION', 'SYMMETRY'])
     if (.not. err%raised) call blk%get_real('FRICTION', w%friction, err, default=0.0_dp, minimum=0.0_dp)
     if (.not. err%raised) call blk%get_real('REACH', w%reach, err, default=0.0_dp, minimum=0.0_dp, maximum=0.99_dp)
+    if (.not. err%raised) call blk%get_string('OPEN', open_ends, err, default='NONE', choices=[character(len=5) :: &
+         'NONE', 'START', 'END', 'BOTH'])
     if (err%raised) return
+    w%open_start = open_ends == 'START' .or. open_ends == 'BOTH'
+    w%open_end = open_ends == 'END' .or. open_ends == 'BOTH'
+    if ((w%open_start .or. w%open_end) .and. (nd /= 2 .or. kind == 'SYMMETRY' .or. w%reach > 0)) then
+       call blk%fail('*MPM WALL, OPEN= is for a 2D friction wall without REACH; expected no OPEN here', err)
+       return
+    end if
     w%kind = wall_friction
     if (kind == 'SYMMETRY') then
        w%kind = wall_symmetry

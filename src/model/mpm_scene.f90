@@ -42,6 +42,9 @@ module mpm_scene
      integer :: kind = wall_friction
      real(dp) :: friction = 0               !< Coulomb μ = tan δ_w
      real(dp) :: reach = 0                  !< nodes up to reach·h in front of the wall are constrained too
+     !> OPEN=START|END|BOTH (2D): at an open end the wall holds the particles, not the grid nodes
+     !> whose support reaches past the end (mpm_wall_edges)
+     logical :: open_start = .false., open_end = .false.
      real(dp) :: p0(3) = 0, p1(3) = 0
      real(dp) :: normal(3) = 0              !< unit, into the material
      logical :: bounded = .false.           !< 3D: limited to lo..hi

@@ -24,6 +24,7 @@ module mpm_musl
   use mpm_sort, only: sort_due, sort_blocks
   use mpm_walls, only: wall_project, surface_find_nodes, surface_wall_project, surface_guard_block, wall_corner_dissipation
   use mpm_setup, only: mark_wall_nodes
+  use mpm_wall_edges, only: any_open_end, open_end_contacts
   use mpm_mirror, only: mirror_fold, mirror_fold_momentum
   use output_effects, only: effects_t
   use mpm_side_friction, only: side_friction_grid, side_friction_work
@@ -174,6 +175,10 @@ contains
 
     call fx%start(fx_g2p)
     call g2p_blocks(m, st, packed, sorted, ilo, ihi)
+    ! *MPM WALL, OPEN=: the particles at a wall's open end, before the remap is summed
+    if (fx%active(fx_walls)) then
+       if (any_open_end(m%mpm%walls, s)) call open_end_contacts(m%mpm%walls, st)
+    end if
     call exchange_grid_sums(st, fx, fx_g2p, .false.)
     do k = 1, size(m%mpm%walls)
        if (st%mirrored(k) .and. m%mpm%walls(k)%active(s)) call mirror_fold_momentum(st%mirror(k), st%g)

@@ -19,6 +19,7 @@ module mpm_setup
   use mpm_particles, only: particle_block_size
   use mpm_shape, only: stencil_nodes_per_direction
   use mpm_walls, only: wall_find_nodes
+  use mpm_wall_edges, only: open_end_support
   use mpm_mirror, only: mirror_plane_setup
   use mpm_stress_update, only: material_work_init
   use material_door, only: checked_packaging_modulus
@@ -131,7 +132,7 @@ contains
           st%mirrored(k) = .false.
           cycle
        end if
-       call wall_find_nodes(m%mpm%walls(k), st%g, st%wall_nodes(k))
+       call wall_find_nodes(m%mpm%walls(k), st%g, st%wall_nodes(k), open_end_support(st%g%h, st%nsup))
        call mirror_plane_setup(m%mpm%walls(k), st%g, st%mirror(k), st%mirrored(k))
        ! a mirrored plane is no wall to the grid: its nodes and images are damped as the full
        ! model's would be (the fold leaves them symmetric)
@@ -229,7 +230,9 @@ contains
     if (.not. allocated(st%on_wall)) allocate (st%on_wall(st%g%nn))
     st%on_wall = .false.
     do k = 1, size(m%mpm%walls)
-       if (m%mpm%walls(k)%active(st%step)) st%on_wall(st%wall_nodes(k)%nodes) = .true.
+       if (.not. m%mpm%walls(k)%active(st%step)) cycle
+       st%on_wall(st%wall_nodes(k)%nodes) = .true.
+       if (allocated(st%wall_nodes(k)%undamped)) st%on_wall(st%wall_nodes(k)%undamped) = .true.
     end do
   end subroutine mark_wall_nodes
 end module mpm_setup

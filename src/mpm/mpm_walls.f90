@@ -31,6 +31,11 @@ module mpm_walls
   !> normal into the material at each of them, normal(3, size(nodes))).
   type, public :: wall_nodes_t
      integer, allocatable :: nodes(:)
+     !> at an open end (OPEN=): the nodes in the stencils of the particles the wall holds there
+     !> (the nodes it leaves free and the row above them). Local damping leaves them alone, as it
+     !> does the wall's nodes (mpm_setup's mark_wall_nodes): the held particles take the wall's
+     !> reaction from them, and damping them held a settled fill 3 % short of its weight.
+     integer, allocatable :: undamped(:)
      real(dp), allocatable :: normal(:, :)
      !> This increment's friction record per node (the booking pass only; wall_corner_dissipation):
      !> hit: a friction projection acted; dv(3, :): the tangential velocity friction removed;
@@ -39,7 +44,7 @@ module mpm_walls
      real(dp), allocatable :: dv(:, :), v_after(:, :), booked(:)
   end type wall_nodes_t
 
-  public :: wall_find_nodes, wall_project, wall_contains, wall_distance, wall_slide_velocity, wall_rows_behind
+  public :: wall_find_nodes, wall_project, wall_contains, near_open_end, wall_distance, wall_slide_velocity, wall_rows_behind
   public :: surface_find_nodes, surface_wall_project, surface_node_velocity, surface_guard_block
   public :: wall_corner_dissipation
 
@@ -100,6 +105,38 @@ contains
     end do
   end subroutine wall_rows_behind
 
+  !> Is x's projection on the 2D wall within `reach` of one of its open ends (OPEN=)?
+  pure logical function near_open_end(w, x, reach)
+    type(mpm_wall_t), intent(in) :: w
+    real(dp), intent(in) :: x(3), reach
+    real(dp) :: t(3), length, s
+
+    near_open_end = .false.
+    if (.not. (w%open_start .or. w%open_end)) return
+    t = w%p1 - w%p0
+    length = norm2(t)
+    s = dot_product(x - w%p0, t) / length
+    near_open_end = (w%open_start .and. s < reach) .or. (w%open_end .and. s > length - reach)
+  end function near_open_end
+
+  !> Is the node x in the stencil of a particle the wall holds at an open end (mpm_wall_edges:
+  !> within 2·support of the end along the wall, closer to it than a cell)? Along the wall from
+  !> −support to 3·support of the end, and at most a support in front of the wall.
+  pure logical function in_open_end_stencils(w, x, support, tol)
+    type(mpm_wall_t), intent(in) :: w
+    real(dp), intent(in) :: x(3), support, tol
+    real(dp) :: t(3), length, s
+
+    in_open_end_stencils = .false.
+    if (.not. (w%open_start .or. w%open_end)) return
+    if (wall_distance(w, x) > support + tol) return
+    t = w%p1 - w%p0
+    length = norm2(t)
+    s = dot_product(x - w%p0, t) / length
+    in_open_end_stencils = (w%open_start .and. s > -support - tol .and. s < 3 * support + tol) .or. &
+         (w%open_end .and. s < length + support + tol .and. s > length - 3 * support - tol)
+  end function in_open_end_stencils
+
   !> Does the wall extend over the point x (its projection lies on the segment / in the box)?
   pure logical function wall_contains(w, ndim, x, tol)
     type(mpm_wall_t), intent(in) :: w
@@ -119,26 +156,37 @@ contains
     end if
   end function wall_contains
 
-  subroutine wall_find_nodes(w, g, wn)
+  !> support: how far a node's shape function reaches [m]; the nodes within it of an open end
+  !> (OPEN=, 2D) are left to the particles (mpm_wall_edges), so the wall's grid condition does
+  !> not reach past the end into the opening.
+  subroutine wall_find_nodes(w, g, wn, support)
     type(mpm_wall_t), intent(in) :: w
     type(grid_t), intent(in) :: g
     type(wall_nodes_t), intent(out) :: wn
-    integer :: i, n
-    integer, allocatable :: list(:)
+    real(dp), intent(in) :: support
+    integer :: i, n, nu
+    integer, allocatable :: list(:), undamped(:)
     real(dp) :: x(3), tol
 
     tol = node_on_wall_tolerance * g%h
-    allocate (list(g%nn))
+    allocate (list(g%nn), undamped(g%nn))
     n = 0
+    nu = 0
     do i = 1, g%nn
        x = g%position(i)
+       if (in_open_end_stencils(w, x, support, tol)) then
+          nu = nu + 1
+          undamped(nu) = i
+       end if
        if (wall_distance(w, x) > w%reach * g%h + tol) cycle
        if (.not. wall_contains(w, g%ndim, x, tol)) cycle
+       if (near_open_end(w, x, support - tol)) cycle
        n = n + 1
        list(n) = i
     end do
-    allocate (wn%nodes(n))
+    allocate (wn%nodes(n), wn%undamped(nu))
     wn%nodes = list(1:n)
+    wn%undamped = undamped(1:nu)
   end subroutine wall_find_nodes
 
   !> Project the velocities v(ndim, nn) of the wall's active nodes; with `force`, add the

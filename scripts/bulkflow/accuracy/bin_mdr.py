@@ -45,6 +45,8 @@ QUICK = dict(young=1.0e6, discharge_time=1.0)
 PIC_TIME = 0.01
 # bulkflow-accuracy --inertial-friction: (φ2 [deg], I0, d [m], ρs [kg/m3]) or None (static MC)
 INERTIAL_FRICTION: tuple[float, float, float, float] | None = None
+# bulkflow-accuracy --open-edge: the floor holds the particles, not the nodes, at the outlet's edge
+OPEN_EDGE = False
 
 
 def members(quick: bool) -> list[dict]:
@@ -84,7 +86,7 @@ def scene(member: dict) -> str:
     # the measure reads the history (MASS_OUT every 0.01 s); one particle frame per second
     text = bin_scene(case="eccentric", sand="NDNS", edge_cells=member["edge_cells"], ppc=1,
                      young=kw["young"], fill_time=0.3, ramp=0.2, discharge_time=kw["discharge_time"],
-                     field_dt=1.0, history_dt=0.01, pic_time=PIC_TIME)
+                     field_dt=1.0, history_dt=0.01, pic_time=PIC_TIME, open_edge=OPEN_EDGE)
     if INERTIAL_FRICTION is not None:
         text = with_inertial_friction(text, INERTIAL_FRICTION)
     return text

@@ -57,6 +57,8 @@ FULL = dict(width=0.20, fill=0.60, young=8.0e6, discharge_time=5.0)
 QUICK = dict(width=0.15, fill=0.50, young=1.0e6, discharge_time=3.0)
 # bulkflow-accuracy --pic-time: *MPM CONTROLS, PIC TIME in every member (0: the scene's FLIP=0.99)
 PIC_TIME = 0.0
+# bulkflow-accuracy --open-edge: the floor holds the particles, not the nodes, at the outlet's edge
+OPEN_EDGE = False
 STATUS_REACHED, STATUS_NOT_REACHED, STATUS_NO_STEADY = "reached", "not reached", "no steady regime"
 
 
@@ -76,7 +78,8 @@ def scene(member: dict) -> str:
     # one particle frame per second is enough: the measure reads the history (MASS_OUT every 0.01 s)
     return bin_scene(case="eccentric", sand="NDNS", edge_cells=member["edge_cells"], ppc=2, outlet=OUTLET,
                      width=kw["width"], fill=kw["fill"], young=kw["young"], fill_time=0.3, ramp=0.2,
-                     discharge_time=kw["discharge_time"], field_dt=1.0, history_dt=0.01, pic_time=PIC_TIME)
+                     discharge_time=kw["discharge_time"], field_dt=1.0, history_dt=0.01, pic_time=PIC_TIME,
+                     open_edge=OPEN_EDGE)
 
 
 def classify(t, mass, t_open, interval: float = T_SS_INTERVAL) -> dict:

@@ -43,6 +43,10 @@ def main(argv=None) -> int:
                         help="hopper-mdr only, repeatable: a keyword of bulkflow.mpm.hopper_scene in every member "
                              "(a number, or true/false), e.g. wall_friction=0 or psi_constant=0; default output "
                              "folder out/accuracy/hopper-mdr-KEY-VALUE")
+    parser.add_argument("--open-edge", action="store_true",
+                        help="hopper-mdr, bin-tss, bin-mdr: the wall at the outlet's edge holds the particles, not "
+                             "the grid nodes (*MPM WALL, OPEN=; docs/accuracy.md); default output folder "
+                             "out/accuracy/KIND-open-edge")
     parser.add_argument("--summarise-only", action="store_true",
                         help="no runs: the summary and outputs again from the measured rows of OUT/KIND.json")
     args = parser.parse_args(argv)
@@ -81,6 +85,12 @@ def main(argv=None) -> int:
         hopper_mdr.SCENE_EXTRA = extra
         kind = dict(kind, title=f"{kind['title']}, with " + ", ".join(args.hopper_scene))
         suffix += "".join(f"-{k}-{v:g}" if not isinstance(v, bool) else f"-{k}-{v}" for k, v in extra.items())
+    if args.open_edge:
+        if args.kind not in MPM_FLOW:
+            parser.error(f"--open-edge applies to {', '.join(MPM_FLOW)} only")
+        MPM_FLOW[args.kind].OPEN_EDGE = True
+        kind = dict(kind, title=f"{kind['title']}, outlet edge open (OPEN=)")
+        suffix += "-open-edge"
     if args.inertial_friction is not None:
         if args.kind not in REGULARISED:
             parser.error(f"--inertial-friction applies to {', '.join(REGULARISED)} only")

@@ -35,6 +35,8 @@ INERTIAL_FRICTION = None
 # bulkflow-accuracy --hopper-scene KEY=VALUE: further hopper_scene keywords in every member (a
 # variant family: wall_friction=0, psi_constant=0, ...)
 SCENE_EXTRA: dict = {}
+# bulkflow-accuracy --open-edge: the wall holds the particles, not the nodes, at the outlet's edge
+OPEN_EDGE = False
 
 
 def members(quick: bool) -> list[dict]:
@@ -51,6 +53,8 @@ def scene(member: dict) -> str:
     if PIC_TIME > 0:
         kw["pic_time"] = PIC_TIME
     kw.update(SCENE_EXTRA)
+    if OPEN_EDGE:
+        kw["open_edge"] = True
     # 2 particle frames in the fill step, 6 in the discharge: the wall force averages the last 3
     text = scene_text(cell=member["cell"], ppc=2, shape="GIMP", field_frames=2, discharge_frames=6, **kw)
     if INERTIAL_FRICTION is not None:

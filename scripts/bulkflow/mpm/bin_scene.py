@@ -121,7 +121,7 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
               psi_max=PSI_MAX, wall_friction=PHI_WALL, right_wall_friction=None, floor_friction=None,
               fill_time=0.3, ramp=0.2, discharge_time=8.0, fill_damping=0.1, flip=0.99, cfl=0.3,
               shape="GIMP", field_dt=0.1, history_dt=0.01, outflow_cells=2.0, side_friction=None,
-              max_dilation=0.0, pic_time=0.0, title=""):
+              max_dilation=0.0, pic_time=0.0, open_edge=False, title=""):
     """The scene text (Abaqus keyword syntax). Angles in degrees; see the module text."""
     if sand not in SANDS:
         raise ValueError(f"sand must be one of {SANDS}")
@@ -157,10 +157,14 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     w(f"{g['x_left']:.9f}, 0.")
     w(f"{g['x_right']:.9f}, {fill:.9f}")
     x0, x1 = g["x_out0"], g["x_out1"]
+    # OPEN= (docs/keywords.md): the floor holds the particles, not the nodes, at the outlet's edge,
+    # and so does the outlet plate at its end there while the fill rests on both
+    opening = (", OPEN=START" if g["half"] else ", OPEN=END") if open_edge else ""
+    plate_opening = (", OPEN=END" if g["half"] else ", OPEN=START") if open_edge else ""
     if g["half"]:
         w("*MPM WALL, NAME=AXIS, TYPE=SYMMETRY")
         w(f"0., {hi[1]:.9f}, 0., {lo[1]:.9f}")
-        w(f"*MPM WALL, NAME=FLOOR, FRICTION={mu_floor:.7f}")
+        w(f"*MPM WALL, NAME=FLOOR, FRICTION={mu_floor:.7f}{opening}")
         w(f"{x1:.9f}, 0., {g['x_right']:.9f}, 0.")
         w(f"*MPM WALL, NAME=RIGHT, FRICTION={mu:.7f}")
         w(f"{g['x_right']:.9f}, 0., {g['x_right']:.9f}, {top:.9f}")
@@ -168,12 +172,12 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     else:
         w(f"*MPM WALL, NAME=LEFT, FRICTION={mu:.7f}")
         w(f"{g['x_left']:.9f}, {top:.9f}, {g['x_left']:.9f}, 0.")
-        w(f"*MPM WALL, NAME=FLOOR, FRICTION={mu_floor:.7f}")
+        w(f"*MPM WALL, NAME=FLOOR, FRICTION={mu_floor:.7f}{opening}")
         w(f"{g['x_left']:.9f}, 0., {x0:.9f}, 0.")
         w(f"*MPM WALL, NAME=RIGHT, FRICTION={mu_right:.7f}")
         w(f"{g['x_right']:.9f}, 0., {g['x_right']:.9f}, {top:.9f}")
         plate = (x0, hi[0])
-    w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu_floor:.7f}")
+    w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu_floor:.7f}{plate_opening}")
     w(f"{plate[0]:.9f}, 0., {plate[1]:.9f}, 0.")
     w(f"*OUTFLOW, BELOW={-outflow_cells * h:.9f}")
     w("** gravity: ramped in the fill step, then on at full value (amplitude in total time)")
@@ -234,6 +238,9 @@ def main(argv=None):
     p.add_argument("--pic-time", type=float, default=0.0, metavar="TAU",
                    help="*MPM CONTROLS, PIC TIME=TAU [s] in place of --flip: the PIC/FLIP blend as a rate, "
                         "independent of the increment (0: off; docs/bins.md)")
+    p.add_argument("--open-edge", action="store_true",
+                   help="the floor holds the particles, not the grid nodes, at the outlet's edge (*MPM WALL, "
+                        "OPEN=; docs/keywords.md)")
     a = p.parse_args(argv)
     if a.pic_time < 0:
         p.error("--pic-time must be >= 0")
@@ -245,7 +252,7 @@ def main(argv=None):
                          floor_friction=a.floor_friction, fill_time=a.fill_time, ramp=a.ramp,
                          discharge_time=a.discharge_time, shape=a.shape, flip=a.flip, cfl=a.cfl,
                          field_dt=a.field_dt, history_dt=a.history_dt, side_friction=a.side_friction,
-                         max_dilation=a.max_dilation, pic_time=a.pic_time)
+                         max_dilation=a.max_dilation, pic_time=a.pic_time, open_edge=a.open_edge)
     except ValueError as e:
         p.error(str(e))
     with open(a.output, "w") as f:

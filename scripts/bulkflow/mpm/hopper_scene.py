@@ -147,7 +147,8 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
                  flip=0.99, cfl=0.3, shape="GIMP", field_frames=10, history_dt=0.01,
                  dilation=True, title="", phi=20.0, psi_initial=15.0, eps_cv=0.2,
                  psi_constant=None, young=1.0e7, poisson=0.2, density=1600.0, model="MC",
-                 wall_reach=None, outflow_cells=2.0, discharge_frames=None, command=None, pic_time=0.0):
+                 wall_reach=None, outflow_cells=2.0, discharge_frames=None, command=None, pic_time=0.0,
+                 open_edge=False):
     """The scene text. `discharge_frames`: field frames of the discharge step (default
     `field_frames`, the number of the fill step); `command`: the command line that wrote the
     file, put in its header (main() passes its own)."""
@@ -189,9 +190,12 @@ def hopper_scene(cell=0.05, ppc=2, theta=30.0, outlet=0.25, height=3.0, wall_fri
     w("*MPM WALL, NAME=AXIS, TYPE=SYMMETRY")
     w(f"0., {hi[1]:.9f}, 0., {lo[1]:.9f}")
     # REACH (docs/keywords.md): the inclined wall also acts on nodes up to REACH cells in front of it
-    w(f"*MPM WALL, NAME=WALL, FRICTION={mu:.7f}" + (f", REACH={wall_reach:g}" if wall_reach is not None else ""))
+    # OPEN= (docs/keywords.md): the wall holds the particles, not the nodes, at the outlet's edge, and
+    # so does the outlet plate at its end there while the fill rests on both
+    w(f"*MPM WALL, NAME=WALL, FRICTION={mu:.7f}" + (f", REACH={wall_reach:g}" if wall_reach is not None else "")
+      + (", OPEN=START" if open_edge else ""))
     w(f"{0.5 * outlet:.9f}, {y0:.9f}, {wall_top[0]:.9f}, {wall_top[1]:.9f}")
-    w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu:.7f}")
+    w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu:.7f}" + (", OPEN=END" if open_edge else ""))
     w(f"{lo[0]:.9f}, {y0:.9f}, {0.5 * outlet:.9f}, {y0:.9f}")
     w(f"*OUTFLOW, BELOW={out_level:.9f}")
     inflow_lines = [f"*INFLOW, MATERIAL={name}, LEVEL={ytop:.9f}, PPC={ppc}", f"0., {xtop:.9f}"] if inflow else []
