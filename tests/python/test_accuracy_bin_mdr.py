@@ -4,7 +4,7 @@ histories (to T_ss, or to the end when the rate held), and the command line's ch
 import numpy as np
 import pytest
 
-from bulkflow.accuracy import bin_mdr, cli, hopper_mdr
+from bulkflow.accuracy import bin_mdr, bin_tss, cli, hopper_mdr
 from bulkflow.mpm.bin_scene import OUTLET
 
 
@@ -98,6 +98,7 @@ def test_measure_stops_at_the_end_of_steady_discharge(tmp_path):
     (["hopper-mdr", "--hopper-scene", "cell=0.1"], "expected KEY=VALUE"),
     (["hopper-mdr", "--hopper-scene", "wall_friction"], "expected KEY=VALUE"),
     (["hopper-mdr", "--hopper-scene", "wall_friction=steel"], "a number or true/false"),
+    (["k0-column", "--open-edge"], "--open-edge applies to"),
 ])
 def test_command_line_refuses(argv, message, capsys):
     with pytest.raises(SystemExit):
@@ -125,3 +126,21 @@ def test_hopper_scene_keywords_reach_every_member(monkeypatch):
     default = hopper_mdr.scene(member)
     assert frictionless != default
     assert "*MPM WALL, NAME=WALL, FRICTION=0.0000000" in frictionless
+
+
+@pytest.mark.parametrize("module, walls", [
+    (hopper_mdr, ("*MPM WALL, NAME=WALL, FRICTION=0.0874887, OPEN=START", "NAME=OUTLET, FRICTION=0.0874887, OPEN=END")),
+    (bin_mdr, ("NAME=FLOOR, FRICTION=0.1227846, OPEN=END", "NAME=OUTLET, FRICTION=0.1227846, OPEN=START")),
+    (bin_tss, ("NAME=FLOOR, FRICTION=0.1227846, OPEN=END", "NAME=OUTLET, FRICTION=0.1227846, OPEN=START")),
+])
+def test_open_edge_opens_the_walls_at_the_outlet_edge_in_every_member(monkeypatch, module, walls):
+    """--open-edge: the wall ending at the outlet's edge and the outlet plate open there (the
+    eccentric bins' floor ends at the outlet, their plate starts there); none without it."""
+    members = module.members(True)
+    assert all("OPEN=" not in module.scene(m) for m in members)
+    monkeypatch.setattr(module, "OPEN_EDGE", True)
+    for m in members:
+        text = module.scene(m)
+        assert text.count("OPEN=") == 2
+        for wall in walls:
+            assert wall in text
