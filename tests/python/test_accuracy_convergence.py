@@ -67,6 +67,20 @@ def test_recommend_picks_cheapest_within_target():
     assert recommend(members, 0.001) is None
 
 
+def test_recommend_needs_the_costlier_members_within_the_target_too():
+    # a coarse member on the reference by chance, a finer one off it: not recommended
+    members = [
+        {"label": "lucky", "error": 0.001, "wall": 1.0},
+        {"label": "off", "error": -0.03, "wall": 4.0},
+        {"label": "no value", "error": float("nan"), "wall": 6.0},
+        {"label": "settled", "error": 0.008, "wall": 9.0},
+        {"label": "finest", "error": 0.004, "wall": 30.0},
+    ]
+    assert recommend(members, 0.01)["label"] == "settled"
+    assert recommend(members, 0.05)["label"] == "lucky"
+    assert recommend(members, 0.005)["label"] == "finest"
+
+
 def test_differences_growing_with_refinement_have_no_order():
     # monotone values whose differences grow as h falls (a drift, not convergence): no p > 0
     h = [0.1, 0.07, 0.05]

@@ -112,9 +112,15 @@ def richardson(h, f, order: float | None = None, safety: float = 1.25, min_order
 
 def recommend(members, target: float, key_error: str = "error", key_cost: str = "wall"):
     """The cheapest member (least `key_cost`) whose |`key_error`| is within `target` (a relative
-    error, 0.02 for ±2 %); None when no member meets it. `members` is a sequence of dicts."""
-    ok = [m for m in members if m.get(key_error) is not None and math.isfinite(m[key_error])
-          and abs(m[key_error]) <= target]
-    if not ok:
-        return None
-    return min(ok, key=lambda m: m[key_cost])
+    error, 0.02 for ±2 %) and stays within it in every costlier member; None when no member meets
+    it. `members` is a sequence of dicts; members without a finite error are not candidates and
+    do not break the run. Why "stays": in a family that scatters about its reference a coarse
+    member can land on it by chance (the 1 m hopper with an open outlet edge: the 3-cell member
+    within 0.14 % of Richardson's value while the 11-cell one was 3.7 % off); a member is worth
+    recommending only if refining from it does not leave the band."""
+    valued = sorted((m for m in members if m.get(key_error) is not None and math.isfinite(m[key_error])),
+                    key=lambda m: m[key_cost])
+    for i, m in enumerate(valued):
+        if all(abs(n[key_error]) <= target for n in valued[i:]):
+            return m
+    return None
