@@ -105,17 +105,27 @@ contains
     end do
   end subroutine wall_rows_behind
 
+  !> The 2D wall's coordinates of x along it: s from p0 (its projection) and the segment's length.
+  pure subroutine along_wall(w, x, s, length)
+    type(mpm_wall_t), intent(in) :: w
+    real(dp), intent(in) :: x(3)
+    real(dp), intent(out) :: s, length
+    real(dp) :: t(3)
+
+    t = w%p1 - w%p0
+    length = norm2(t)
+    s = dot_product(x - w%p0, t) / length
+  end subroutine along_wall
+
   !> Is x's projection on the 2D wall within `reach` of one of its open ends (OPEN=)?
   pure logical function near_open_end(w, x, reach)
     type(mpm_wall_t), intent(in) :: w
     real(dp), intent(in) :: x(3), reach
-    real(dp) :: t(3), length, s
+    real(dp) :: s, length
 
     near_open_end = .false.
     if (.not. (w%open_start .or. w%open_end)) return
-    t = w%p1 - w%p0
-    length = norm2(t)
-    s = dot_product(x - w%p0, t) / length
+    call along_wall(w, x, s, length)
     near_open_end = (w%open_start .and. s < reach) .or. (w%open_end .and. s > length - reach)
   end function near_open_end
 
@@ -125,14 +135,12 @@ contains
   pure logical function in_open_end_stencils(w, x, support, tol)
     type(mpm_wall_t), intent(in) :: w
     real(dp), intent(in) :: x(3), support, tol
-    real(dp) :: t(3), length, s
+    real(dp) :: s, length
 
     in_open_end_stencils = .false.
     if (.not. (w%open_start .or. w%open_end)) return
     if (wall_distance(w, x) > support + tol) return
-    t = w%p1 - w%p0
-    length = norm2(t)
-    s = dot_product(x - w%p0, t) / length
+    call along_wall(w, x, s, length)
     in_open_end_stencils = (w%open_start .and. s > -support - tol .and. s < 3 * support + tol) .or. &
          (w%open_end .and. s < length + support + tol .and. s > length - 3 * support - tol)
   end function in_open_end_stencils
