@@ -34,7 +34,7 @@ contains
          do ib = 1, st%nblocks
             associate (b => st%blocks(ib))
               ! the few particles behind the wall first, then each of them as before
-              call wall_rows_behind(w, b%count, nd, b%x, dist, nrows, rows)
+              call wall_rows_behind(w, b%count, nd, b%x, 0.0_dp, dist, nrows, rows)
               do j = 1, nrows
                  p = rows(j)
                  x = 0

@@ -14,8 +14,8 @@
 module mpm_wall_edges
   use base_kinds, only: dp
   use mpm_scene, only: mpm_wall_t
-  use mpm_walls, only: wall_distance, wall_contains, wall_slide_velocity, near_open_end
-  use mpm_particles, only: particle_block_t
+  use mpm_walls, only: wall_distance, wall_contains, wall_slide_velocity, near_open_end, wall_rows_behind
+  use mpm_particles, only: particle_block_t, particle_block_size
   use mpm_state, only: mpm_state_t, sum_over_ranks
   implicit none
   private
@@ -85,12 +85,17 @@ contains
     real(dp), intent(in) :: support, dt, gravity(3), v_new(:, :)
     type(particle_block_t), intent(inout) :: b
     real(dp), intent(inout) :: gmom(:, :), force(3), dissipated, wk
-    integer :: p, i, j, node, nsup
-    real(dp) :: x(3), v(2), vnew(2), dv(2), n(2), t_old, t_new, ws, sv(2), ds(2)
+    integer :: p, i, j, node, nsup, k, nrows, rows(particle_block_size)
+    real(dp) :: x(3), v(2), vnew(2), dv(2), n(2), t_old, t_new, ws, sv(2), ds(2), d(particle_block_size)
 
     nsup = size(b%w1, 2)
     n = w%normal(1:2)
-    do p = 1, b%count
+    ! A vectorised pre-filter first (the scalar scan of every particle was 2 % of a bin
+    ! increment's CPU samples): the rows a hair wider than the first row's band, then the exact
+    ! tests on those, so the rows held are the same.
+    call wall_rows_behind(w, b%count, 2, b%x, 2 * b%half * (1 + 1.0e-6_dp), d, nrows, rows)
+    do k = 1, nrows
+       p = rows(k)
        x = 0
        x(1:2) = b%x(p, 1:2)
        if (.not. wall_distance(w, x) < 2 * b%half) cycle

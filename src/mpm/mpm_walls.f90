@@ -62,18 +62,19 @@ contains
     wall_distance = dot_product(x - w%p0, w%normal)
   end function wall_distance
 
-  !> The rows of x(nb, nd) (points of a particle block) behind the wall's line/plane, i.e. not
-  !> wall_distance >= 0 (a NaN counts, as in the caller's test before), ascending: rows(1:nrows).
+  !> The rows of x(nb, nd) (points of a particle block) less than `level` in front of the wall's
+  !> line/plane, i.e. not wall_distance >= level (level 0: behind it; a NaN counts, as in the
+  !> caller's test before), ascending: rows(1:nrows).
   !> Why a kernel: the scan of every particle against every active wall, a scalar loop that
   !> built a 3-vector per particle, was 4 % of the instructions of a hopper increment. The
   !> distance is wall_distance's dot product without its leading 0 + (the same value but for
   !> the sign of a zero, so the same decision), so the loop vectorises; the caller recomputes
   !> wall_distance for the rows it gets. d(nb): the caller's work array (an automatic array
   !> here would be a malloc per call).
-  pure subroutine wall_rows_behind(w, nb, nd, x, d, nrows, rows)
+  pure subroutine wall_rows_behind(w, nb, nd, x, level, d, nrows, rows)
     type(mpm_wall_t), intent(in) :: w
     integer, intent(in) :: nb, nd
-    real(dp), intent(in) :: x(nb, nd)
+    real(dp), intent(in) :: x(nb, nd), level
     real(dp), intent(out) :: d(nb)
     integer, intent(out) :: nrows, rows(nb)
     real(dp) :: a1, a2, a3, n1, n2, n3, t3
@@ -98,7 +99,7 @@ contains
     end if
     nrows = 0
     do p = 1, nb
-       if (.not. d(p) >= 0) then
+       if (.not. d(p) >= level) then
           nrows = nrows + 1
           rows(nrows) = p
        end if
