@@ -79,8 +79,32 @@ def main() -> int:
     for m in members:
         check(m["wall"] > 0 and m["cpu"] > 0 and m["increments"] > 0,
               f"{m['label']}: measured wall {m['wall']:.3g} s, CPU {m['cpu']:.3g} s, {m['increments']} increments")
+    if a.kind == "wave-bar":
+        check_reuse(cmd, out / "reuse", members, check)
     print(f"{len(failures)} check(s) failed" if failures else "all checks passed")
     return 1 if failures else 0
+
+
+def check_reuse(cmd, out, members, check) -> None:
+    """--reuse twice into a fresh folder: the first runs every member, the second none (each line
+    says it was reused, no new solver log) and writes the same values and measured times."""
+    cmd = [c if c != str(cmd[cmd.index("--out") + 1]) else str(out) for c in cmd] + ["--reuse"]
+    found = []
+    for attempt in (1, 2):
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        print(proc.stdout + proc.stderr)
+        if proc.returncode != 0:
+            check(False, f"--reuse run {attempt} exited with {proc.returncode}")
+            return
+        logs = sorted(p.stat().st_mtime_ns for p in (out / "runs").glob("*.log"))
+        found.append((proc.stdout.count("reused: measured by an earlier run"), logs,
+                      json.loads((out / "wave-bar.json").read_text())["members"]))
+    (n1, logs1, m1), (n2, logs2, m2) = found
+    check(n1 == 0 and len(logs1) == len(members), f"--reuse, first: {len(logs1)} runs, none reused")
+    check(n2 == len(members) and logs2 == logs1, f"--reuse, second: {n2} of {len(members)} reused, no new run")
+    check([(m["value"], m["wall"], m["cpu"]) for m in m1] == [(m["value"], m["wall"], m["cpu"]) for m in m2],
+          "--reuse, second: the same values and measured times")
+    check(all(m["reused"] for m in m2) and not any(m["reused"] for m in m1), "--reuse: the rows say which were reused")
 
 
 def check_bin_tss(summary, members, check) -> None:

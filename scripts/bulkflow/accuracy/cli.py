@@ -47,6 +47,10 @@ def main(argv=None) -> int:
                         help="hopper-mdr, bin-tss, bin-mdr: the wall at the outlet's edge holds the particles, not "
                              "the grid nodes (*MPM WALL, OPEN=; docs/accuracy.md); default output folder "
                              "out/accuracy/KIND-open-edge")
+    parser.add_argument("--reuse", action="store_true",
+                        help="do not run again a member whose deck, rank count and solver binary ran to the end "
+                             "in OUT/runs before (its measured times are kept): continues an interrupted family, "
+                             "extends one by --edge-cells; not for arching-cow")
     parser.add_argument("--summarise-only", action="store_true",
                         help="no runs: the summary and outputs again from the measured rows of OUT/KIND.json")
     args = parser.parse_args(argv)
@@ -62,6 +66,8 @@ def main(argv=None) -> int:
         if arching_cow.criterion_supported() is None:
             parser.error("--criterion: this checkout's bulkflow.arching has no flow criterion option")
         arching_cow.CRITERION = args.criterion
+    if args.reuse and "run" in kind:
+        parser.error(f"--reuse: a member of {args.kind} is a search of several runs; it cannot be reused")
     if args.pic_time is not None:
         if args.kind not in MPM_FLOW:
             parser.error(f"--pic-time applies to {', '.join(MPM_FLOW)} only")
@@ -109,7 +115,7 @@ def main(argv=None) -> int:
         s = resummarise(kind, out)
     else:
         try:
-            s = run_family(kind, args.quick, out, ranks=args.ranks, solver=args.solver)
+            s = run_family(kind, args.quick, out, ranks=args.ranks, solver=args.solver, reuse=args.reuse)
         except (FileNotFoundError, RuntimeError) as exc:      # no solver, or a run that failed
             print(f"bulkflow-accuracy: {exc}", file=sys.stderr)
             return 2

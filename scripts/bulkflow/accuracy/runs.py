@@ -5,7 +5,9 @@ rule and the same Open MPI environment as bulkflow.arching.runner, whose public 
 """
 from __future__ import annotations
 
+import hashlib
 import importlib.util
+import json
 import re
 import shutil
 from dataclasses import dataclass
@@ -42,6 +44,50 @@ def run_deck(text: str, workdir: Path, name: str, ranks: int = 1, solver: str | 
                            f"{(proc.stdout + proc.stderr)[-2000:]}")
     m = _DONE.search(proc.stdout)
     return Timing(wall, cpu, int(m.group(1)) if m else 0, base)
+
+
+_SOLVER_DIGESTS: dict[tuple, str] = {}
+
+
+def solver_digest(solver: str | None = None) -> str:
+    """sha256 of the solver binary's bytes (kept per path, size and mtime: hashed once a family)."""
+    path = solver_path(solver)
+    st = path.stat()
+    key = (str(path.resolve()), st.st_size, st.st_mtime_ns)
+    if key not in _SOLVER_DIGESTS:
+        _SOLVER_DIGESTS[key] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return _SOLVER_DIGESTS[key]
+
+
+def deck_key(text: str, ranks: int, solver: str | None = None) -> str:
+    """What a finished run's results depend on: the deck's text, the rank count and the solver's
+    bytes (12 hex digits of their sha256)."""
+    h = hashlib.sha256(text.encode())
+    h.update(f"\0ranks={ranks}\0".encode())
+    h.update(solver_digest(solver).encode())
+    return h.hexdigest()[:12]
+
+
+def run_deck_reusing(text: str, workdir: Path, name: str, ranks: int = 1,
+                     solver: str | None = None) -> tuple[Timing, bool]:
+    """run_deck under the name NAME-KEY (KEY = deck_key), unless a run of the same deck, rank
+    count and solver binary finished there before: then its outputs and its measured wall and
+    CPU times are returned without running (True: reused). A run is finished when its
+    NAME-KEY.done.json exists, written only after the solver exited with status 0, so an
+    interrupted family is continued by the same command and a changed member, rank count or
+    binary is run again."""
+    workdir = Path(workdir)
+    key = deck_key(text, ranks, solver)
+    name = f"{name}-{key}"
+    stamp = workdir / f"{name}.done.json"
+    if stamp.exists():
+        done = json.loads(stamp.read_text())
+        if done.get("key") == key and Path(f"{workdir / name}_history.csv").exists():
+            return Timing(done["wall"], done["cpu"], done["increments"], workdir / name), True
+    timing = run_deck(text, workdir, name, ranks=ranks, solver=solver)
+    stamp.write_text(json.dumps({"key": key, "ranks": ranks, "solver_sha256": solver_digest(solver),
+                                 "wall": timing.wall, "cpu": timing.cpu, "increments": timing.increments}))
+    return timing, False
 
 
 def particles_from_log(base) -> int:

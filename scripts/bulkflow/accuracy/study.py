@@ -19,20 +19,33 @@ import time
 from pathlib import Path
 
 from .convergence import order_from_errors, order_from_values, recommend, richardson
-from .runs import run_deck
+from .runs import run_deck, run_deck_reusing
 
 TARGETS = (0.01, 0.02, 0.05)
 
 
-def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str | None = None, log=print) -> dict:
+def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str | None = None, log=print,
+               reuse: bool = False) -> dict:
+    """reuse: a member whose deck, rank count and solver binary ran to the end in OUT/runs before
+    is not run again; its row keeps the wall and CPU times measured then (runs.run_deck_reusing).
+    Not for kinds whose member is a search (arching-cow)."""
     out = Path(out)
     runs = out / "runs"
     rows = []
     t_start = time.perf_counter()
+    if reuse and "run" in kind:
+        raise ValueError(f"{kind['name']}: a member is a search of several runs; reuse is not supported")
     for member in kind["members"](quick):
         name = f"{kind['name'].replace('-', '_')}_{len(rows)}"
+        reused = False
         if "run" in kind:                  # a member that is more than one solver run (a search)
             timing, res = kind["run"](member, runs, ranks, solver)
+        elif reuse:
+            # named by the deck's key and not the member's place: a family extended by a finer
+            # member or started with another list finds its members wherever they were
+            timing, reused = run_deck_reusing(kind["scene"](member), runs, kind["name"].replace("-", "_"),
+                                              ranks=ranks, solver=solver)
+            res = kind["measure"](timing.base, member)
         else:
             timing = run_deck(kind["scene"](member), runs, name, ranks=ranks, solver=solver)
             res = kind["measure"](timing.base, member)
@@ -41,13 +54,16 @@ def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str |
                                                               if k not in ("label", "h")},
                "wall": timing.wall, "cpu": timing.cpu, "increments": timing.increments, "ranks": ranks,
                **res}
+        if reuse:
+            row["reused"] = reused
         # the work (element- or particle-steps) orders the members by cost independently of the
         # machine's load; the wall and CPU times are what was measured
         row["work"] = work if work is not None else timing.increments * (res.get("particles") or member["elements"])
         rows.append(row)
         log(f"  {member['label']:<40s} value {_show_value(res['value'])}"
             + (f"  error {100 * res['error']:.3g} %" if res.get("error") is not None else "")
-            + f"  [{timing.wall:.2f} s wall, {timing.cpu:.2f} s cpu, {timing.increments} inc]")
+            + f"  [{timing.wall:.2f} s wall, {timing.cpu:.2f} s cpu, {timing.increments} inc"
+            + ("; reused: measured by an earlier run" if reused else "") + "]")
     summary = summarise(kind, rows)
     summary["total_wall"] = time.perf_counter() - t_start
     summary["quick"] = quick
@@ -73,7 +89,7 @@ def resummarise(kind: dict, out: Path) -> dict:
     keep = ("label", "h", "wall", "cpu", "increments", "ranks", "work", "value", "particles", "elements",
             "n", "cell", "n_arc", "tol", "no_flow", "flow", "runs", "quick_case", "sv_l2", "sv_centroid",
             "k0", "settlement", "wall_force", "edge_cells", "tss_status", "tss_rule", "steady_windows",
-            "mdr", "discharged")
+            "mdr", "discharged", "reused")
     rows = [{k: m[k] for k in keep if k in m} for m in old["members"]]
     if kind["reference"] == "exact":
         for r, m in zip(rows, old["members"]):
