@@ -48,6 +48,9 @@ def add_arguments(p):
                    help="*MPM CONTROLS, PIC TIME=TAU [s] in every run: the PIC/FLIP blend as a rate, "
                         "the discharge independent of E and the increment (0: the fixed FLIP=0.99 of the "
                         "runs before 2026-12-06; docs/bins.md)")
+    p.add_argument("--open-edge", action="store_true",
+                   help="the floor and the outlet plate hold the particles at the outlet's edge, not the grid "
+                        "nodes whose support reaches into the opening (*MPM WALL, OPEN=; docs/accuracy.md)")
     p.add_argument("--variants", action="store_true", help="also the 34 deg right wall and rho_i = 1600 runs")
     p.add_argument("--cases", nargs="+",
                    help="only these, e.g. concentric:NDNS eccentric:DS:4 (a third field: its own discharge time [s])")
@@ -80,6 +83,8 @@ def _runs(a):
         scene = dict(case=case, sand=sand, edge_cells=a.edge_cells, ppc=a.ppc, discharge_time=a.discharge,
                      fill_time=a.fill_time, young=a.young, max_dilation=a.max_dilation,
                      pic_time=a.pic_time)
+        if a.open_edge:
+            scene["open_edge"] = True
         scene.update(kw)
         r = run_bin(a.bulkflow, a.runs, reuse=not a.no_reuse, **scene)
         # the figures from the history, not the cached record: runs made before the plateau rule
@@ -140,7 +145,8 @@ def run(a):
     print(f"flat-bottomed bins (thesis ch. 5): outlet {OUTLET * 1e3:g} mm, cell outlet/{2 * a.edge_cells + 1}, "
           f"PPC {a.ppc}, E {a.young / 1e6:g} MPa, fill {a.fill_time:g} s + discharge {a.discharge:g} s (or the case's own)"
           + (f", MAX DILATION {a.max_dilation:g}" if a.max_dilation > 0 else "")
-          + (f", PIC TIME {a.pic_time:g} s" if a.pic_time > 0 else ""), flush=True)
+          + (f", PIC TIME {a.pic_time:g} s" if a.pic_time > 0 else "")
+          + (", outlet edge open (OPEN=)" if a.open_edge else ""), flush=True)
     rows = _runs(a)
     bev = {C: beverloo_per_metre(RHO_I, C) for C in (0.64, 0.58)}
     table = []
