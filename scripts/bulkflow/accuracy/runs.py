@@ -9,11 +9,14 @@ import hashlib
 import importlib.util
 import json
 import re
+import resource
 import shutil
+import subprocess
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..arching.runner import run_timed, solver_path
+from ..arching.runner import mpi_environment, solver_path
 
 REPO = Path(__file__).resolve().parents[3]
 _DONE = re.compile(r"bulkflow: done, (\d+) increments")
@@ -29,21 +32,37 @@ class Timing:
 
 def run_deck(text: str, workdir: Path, name: str, ranks: int = 1, solver: str | None = None) -> Timing:
     """Write `text` to workdir/name.inp, run it on `ranks` ranks, return the timing. The solver's
-    output goes to workdir/name.log; a failure raises RuntimeError with its last lines."""
+    output goes to workdir/name.log as it runs, with its progress lines (step, time, ETA every
+    2 s: `tail -f` that log to follow a long member); a failure raises RuntimeError with its last
+    lines."""
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     inp = workdir / f"{name}.inp"
     inp.write_text(text)
     base = workdir / name
-    cmd = [str(solver_path(solver)), str(inp), "--output", str(base), "--quiet"]
+    cmd = [str(solver_path(solver)), str(inp), "--output", str(base)]
     if ranks > 1:
         cmd = [shutil.which("mpirun") or "mpirun", "-np", str(ranks)] + cmd
-    proc, wall, cpu = run_timed(cmd, workdir / f"{name}.log")
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed with status {proc.returncode}:\n"
-                           f"{(proc.stdout + proc.stderr)[-2000:]}")
-    m = _DONE.search(proc.stdout)
+    log = workdir / f"{name}.log"
+    status, output, wall, cpu = run_logged(cmd, log)
+    if status != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed with status {status}:\n{output[-2000:]}")
+    m = _DONE.search(output)
     return Timing(wall, cpu, int(m.group(1)) if m else 0, base)
+
+
+def run_logged(cmd: list[str], log: Path) -> tuple[int, str, float, float]:
+    """Run a solver command line with the MPI environment, its stdout and stderr written to `log`
+    while it runs: exit status, the log's text, wall time and the CPU time (user + system) of the
+    children it started [s]."""
+    t0 = time.perf_counter()
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    with open(log, "w") as handle:
+        proc = subprocess.run(cmd, stdout=handle, stderr=subprocess.STDOUT, env=mpi_environment())
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    return proc.returncode, log.read_text(errors="replace"), wall, cpu
 
 
 _SOLVER_DIGESTS: dict[tuple, str] = {}

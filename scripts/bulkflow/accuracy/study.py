@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 from .convergence import order_from_errors, order_from_values, recommend, richardson
-from .runs import run_deck, run_deck_reusing
+from .runs import deck_key, run_deck, run_deck_reusing
 
 TARGETS = (0.01, 0.02, 0.05)
 
@@ -35,19 +35,25 @@ def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str |
     t_start = time.perf_counter()
     if reuse and "run" in kind:
         raise ValueError(f"{kind['name']}: a member is a search of several runs; reuse is not supported")
-    for member in kind["members"](quick):
+    members = kind["members"](quick)
+    for member in members:
         name = f"{kind['name'].replace('-', '_')}_{len(rows)}"
         reused = False
         if "run" in kind:                  # a member that is more than one solver run (a search)
             timing, res = kind["run"](member, runs, ranks, solver)
-        elif reuse:
-            # named by the deck's key and not the member's place: a family extended by a finer
-            # member or started with another list finds its members wherever they were
-            timing, reused = run_deck_reusing(kind["scene"](member), runs, kind["name"].replace("-", "_"),
-                                              ranks=ranks, solver=solver)
-            res = kind["measure"](timing.base, member)
         else:
-            timing = run_deck(kind["scene"](member), runs, name, ranks=ranks, solver=solver)
+            text = kind["scene"](member)
+            if reuse:
+                # named by the deck's key and not the member's place: a family extended by a finer
+                # member or started with another list finds its members wherever they were
+                name = f"{kind['name'].replace('-', '_')}-{deck_key(text, ranks, solver)}"
+            log(f"  ... {member['label']} (member {len(rows) + 1} of {len(members)}; "
+                f"solver progress: {runs / name}.log)")
+            if reuse:
+                timing, reused = run_deck_reusing(text, runs, kind["name"].replace("-", "_"), ranks=ranks,
+                                                  solver=solver)
+            else:
+                timing = run_deck(text, runs, name, ranks=ranks, solver=solver)
             res = kind["measure"](timing.base, member)
         work = res.pop("work_override", None)
         row = {"label": member["label"], "h": member["h"], **{k: v for k, v in member.items()
