@@ -8,7 +8,7 @@
 !>   *PARTICLES, MATERIAL=name [, PPC=n] [, TYPE=BOX|POLYGON] [, Z1=, Z2=] [, VX=, VY=, VZ=]
 !>                                                  data: BOX lo; hi  |  POLYGON x, y per line
 !>   *MPM WALL, NAME=w [, TYPE=FRICTION|SYMMETRY] [, FRICTION=μ] [, REACH=r] [, OPEN=START|END|BOTH]
-!>     [, OP=DELETE]
+!>     [, OPEN=XLOW|...|ZHIGH (3D)] [, OP=DELETE]   OPEN: scene_mpm_wall_open
 !>                                                  data 2D: x0, y0, x1, y1 (material on the left)
 !>                                                  data 3D: px, py, pz, nx, ny, nz [; lo; hi]
 !>   *OUTFLOW, BELOW=y                              model data: particles below y leave
@@ -37,6 +37,7 @@ module scene_mpm
   use scene_mpm_decomposition, only: read_decomposition
   use scene_mpm_controls, only: read_mpm_controls
   use scene_mpm_nonlocal, only: read_nonlocal
+  use scene_mpm_wall_open, only: read_wall_open
   use scene_util, only: itoa, rtoa, get_real, expect_lines, expect_fields, last_field, where_text, &
        check_name
   implicit none
@@ -413,7 +414,7 @@ contains
     type(error_t), intent(inout) :: err
     type(mpm_wall_t) :: w
     type(mpm_wall_t), allocatable :: grown(:)
-    character(len=:), allocatable :: name, kind, op, open_ends
+    character(len=:), allocatable :: name, kind, op
     integer :: nd, k, n, found
     real(dp) :: t(3), length
 
@@ -454,15 +455,7 @@ contains
     call blk%get_string('TYPE', kind, err, default='FRICTION', choices=[character(len=8) :: 'FRICTION', 'SYMMETRY'])
     if (.not. err%raised) call blk%get_real('FRICTION', w%friction, err, default=0.0_dp, minimum=0.0_dp)
     if (.not. err%raised) call blk%get_real('REACH', w%reach, err, default=0.0_dp, minimum=0.0_dp, maximum=0.99_dp)
-    if (.not. err%raised) call blk%get_string('OPEN', open_ends, err, default='NONE', choices=[character(len=5) :: &
-         'NONE', 'START', 'END', 'BOTH'])
     if (err%raised) return
-    w%open_start = open_ends == 'START' .or. open_ends == 'BOTH'
-    w%open_end = open_ends == 'END' .or. open_ends == 'BOTH'
-    if ((w%open_start .or. w%open_end) .and. (nd /= 2 .or. kind == 'SYMMETRY' .or. w%reach > 0)) then
-       call blk%fail('*MPM WALL, OPEN= is for a 2D friction wall without REACH; expected no OPEN here', err)
-       return
-    end if
     w%kind = wall_friction
     if (kind == 'SYMMETRY') then
        w%kind = wall_symmetry
@@ -518,6 +511,8 @@ contains
           end do
        end if
     end if
+    call read_wall_open(blk, nd, kind == 'SYMMETRY', w, err)
+    if (err%raised) return
     allocate (w%active(nsteps))
     w%active = .false.
     w%active(max(s, 1):) = .true.

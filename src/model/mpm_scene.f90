@@ -43,8 +43,10 @@ module mpm_scene
      real(dp) :: friction = 0               !< Coulomb μ = tan δ_w
      real(dp) :: reach = 0                  !< nodes up to reach·h in front of the wall are constrained too
      !> OPEN=START|END|BOTH (2D): at an open end the wall holds the particles, not the grid nodes
-     !> whose support reaches past the end (mpm_wall_edges)
+     !> whose support reaches past the end (mpm_wall_edges). 3D (OPEN=XLOW ... ZHIGH): the wall's
+     !> box face on axis open_axis, its low (open_start) or high (open_end) side
      logical :: open_start = .false., open_end = .false.
+     integer :: open_axis = 0               !< 0: 2D, along p0 -> p1; 1..3: 3D, the box's axis
      real(dp) :: p0(3) = 0, p1(3) = 0
      real(dp) :: normal(3) = 0              !< unit, into the material
      logical :: bounded = .false.           !< 3D: limited to lo..hi

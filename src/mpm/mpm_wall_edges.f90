@@ -1,5 +1,5 @@
-!> The open ends of 2D walls (*MPM WALL, OPEN=START|END|BOTH; docs/theory/mpm.md §4.4, "Open
-!> wall ends"). A wall's grid condition acts on nodes, and a node's shape function reaches a cell
+!> The open ends of walls (*MPM WALL, OPEN=START|END|BOTH in 2D, OPEN=XLOW ... ZHIGH, a face of
+!> the wall's box, in 3D; docs/theory/mpm.md §4.4, "Open wall ends"). A wall's grid condition acts on nodes, and a node's shape function reaches a cell
 !> and a half (uGIMP) past it: the floor node next to an outlet's edge holds the sand above the
 !> opening too, and the outlet discharges as if it were narrower by about a cell at each edge (a
 !> first-order error in h, docs/accuracy.md). At an open end the wall leaves the nodes whose
@@ -61,7 +61,7 @@ contains
        if (.not. walls(k)%active(st%step)) cycle
        if (.not. (walls(k)%open_start .or. walls(k)%open_end)) cycle
        do ib = 1, st%nblocks
-          call block_open_end_contact(walls(k), st%g%n(1), support, st%dt, st%gravity, st%g%v_new, &
+          call block_open_end_contact(walls(k), st%g%n, support, st%dt, st%gravity, st%g%v_new, &
                st%blocks(ib), st%g%mom, acc(3 * k - 2:3 * k), acc(3 * nw + 1), st%w_external)
        end do
     end do
@@ -71,60 +71,76 @@ contains
     st%e_walls = st%e_walls + acc(3 * nw + 1)
   end subroutine open_end_contacts
 
-  !> One 2D block against one wall: the particles over it within 2·support of an open end (their
-  !> stencil holds a node the wall left free) and closer to it than twice their half-length (the
-  !> first row on it) lose their approaching velocity (wall_slide_velocity); m Δv leaves gmom(2,
-  !> nodes) through the stencil (corner, w1 of this increment; nx nodes per grid row), −m Δv/Δt
-  !> is the reaction added to force, m (|v_t| − |v_t,new|) |v_t,new| the friction work added to
-  !> dissipated (the nodes' booking, mpm_walls' wall_project). The displacement G2P gave it,
-  !> Δt s with s = Σ S v_new (grid v_new(2, nodes)), becomes Δt slide(s), and gravity's work
-  !> m g·Δt s booked on it in wk the same.
-  subroutine block_open_end_contact(w, nx, support, dt, gravity, v_new, b, gmom, force, dissipated, wk)
+  !> One block (2D or 3D: the columns of its x) against one wall: the particles over it within
+  !> 2·support of an open end (their stencil holds a node the wall left free) and closer to it
+  !> than twice their half-length (the first row on it) lose their approaching velocity
+  !> (wall_slide_velocity); m Δv leaves gmom(:, nodes) through the stencil (corner, w1 of this
+  !> increment; n: grid nodes per axis), −m Δv/Δt is the reaction added to force, m (|v_t| −
+  !> |v_t,new|) |v_t,new| the friction work added to dissipated (the nodes' booking, mpm_walls'
+  !> wall_project). The displacement G2P gave it, Δt s with s = Σ S v_new (grid v_new(:, nodes)),
+  !> becomes Δt slide(s), and gravity's work m g·Δt s booked on it in wk the same.
+  subroutine block_open_end_contact(w, n, support, dt, gravity, v_new, b, gmom, force, dissipated, wk)
     type(mpm_wall_t), intent(in) :: w
-    integer, intent(in) :: nx
+    integer, intent(in) :: n(3)
     real(dp), intent(in) :: support, dt, gravity(3), v_new(:, :)
     type(particle_block_t), intent(inout) :: b
     real(dp), intent(inout) :: gmom(:, :), force(3), dissipated, wk
-    integer :: p, i, j, node, nsup, k, nrows, rows(particle_block_size)
-    real(dp) :: x(3), v(2), vnew(2), dv(2), n(2), t_old, t_new, ws, sv(2), ds(2), d(particle_block_size)
+    integer :: p, i, j, k, node, nsup, nd, nc, row, nrows, rows(particle_block_size)
+    real(dp) :: x(3), xs(3), v(3), vnew(3), dv(3), normal(3), t_old, t_new, ws, sv(3), ds(3), d(particle_block_size)
 
     nsup = size(b%w1, 2)
-    n = w%normal(1:2)
+    nd = size(b%x, 2)
+    nc = merge(nsup, 1, nd == 3)
+    normal = w%normal
     ! A vectorised pre-filter first (the scalar scan of every particle was 2 % of a bin
     ! increment's CPU samples): the rows a hair wider than the first row's band, then the exact
     ! tests on those, so the rows held are the same.
-    call wall_rows_behind(w, b%count, 2, b%x, 2 * b%half * (1 + 1.0e-6_dp), d, nrows, rows)
-    do k = 1, nrows
-       p = rows(k)
+    call wall_rows_behind(w, b%count, nd, b%x, 2 * b%half * (1 + 1.0e-6_dp), d, nrows, rows)
+    do row = 1, nrows
+       p = rows(row)
        x = 0
-       x(1:2) = b%x(p, 1:2)
+       x(1:nd) = b%x(p, :)
        if (.not. wall_distance(w, x) < 2 * b%half) cycle
-       if (.not. wall_contains(w, 2, x, 0.0_dp)) cycle
-       if (.not. near_open_end(w, x, 2 * support)) cycle
+       ! 3D: where the particle is over the plane (its foot on it), since the box bounds the
+       ! plane and the nodes behind it, not the space in front; 2D: the segment's projection
+       xs = x
+       if (nd == 3) xs = x - wall_distance(w, x) * normal
+       if (.not. wall_contains(w, nd, xs, 0.0_dp)) cycle
+       if (.not. near_open_end(w, xs, 2 * support)) cycle
        sv = 0
-       do j = 1, nsup
-          do i = 1, nsup
-             node = b%corner(p) + (i - 1) + nx * (j - 1)
-             sv = sv + b%w1(p, i, 1) * b%w1(p, j, 2) * v_new(1:2, node)
+       do k = 1, nc
+          do j = 1, nsup
+             do i = 1, nsup
+                node = b%corner(p) + (i - 1) + n(1) * (j - 1) + n(1) * n(2) * (k - 1)
+                ws = b%w1(p, i, 1) * b%w1(p, j, 2)
+                if (nd == 3) ws = ws * b%w1(p, k, 3)
+                sv(1:nd) = sv(1:nd) + ws * v_new(1:nd, node)
+             end do
           end do
        end do
-       ds = wall_slide_velocity(w, 2, sv) - sv
-       b%x(p, 1:2) = b%x(p, 1:2) + dt * ds
-       wk = wk + b%mass(p) * dt * dot_product(gravity(1:2), ds)
-       v = b%v(p, 1:2)
-       vnew = wall_slide_velocity(w, 2, v)
+       ds = 0
+       ds(1:nd) = wall_slide_velocity(w, nd, sv(1:nd)) - sv(1:nd)
+       b%x(p, :) = b%x(p, :) + dt * ds(1:nd)
+       wk = wk + b%mass(p) * dt * dot_product(gravity, ds)
+       v = 0
+       v(1:nd) = b%v(p, :)
+       vnew = 0
+       vnew(1:nd) = wall_slide_velocity(w, nd, v(1:nd))
        dv = vnew - v
        if (dot_product(dv, dv) <= 0) cycle
-       b%v(p, 1:2) = vnew
-       force(1:2) = force(1:2) - b%mass(p) * dv / dt
-       t_old = norm2(v - dot_product(v, n) * n)
-       t_new = norm2(vnew - dot_product(vnew, n) * n)
+       b%v(p, :) = vnew(1:nd)
+       force = force - b%mass(p) * dv / dt
+       t_old = norm2(v - dot_product(v, normal) * normal)
+       t_new = norm2(vnew - dot_product(vnew, normal) * normal)
        dissipated = dissipated + b%mass(p) * (t_old - t_new) * t_new
-       do j = 1, nsup
-          do i = 1, nsup
-             node = b%corner(p) + (i - 1) + nx * (j - 1)
-             ws = b%w1(p, i, 1) * b%w1(p, j, 2)
-             gmom(1:2, node) = gmom(1:2, node) + ws * b%mass(p) * dv
+       do k = 1, nc
+          do j = 1, nsup
+             do i = 1, nsup
+                node = b%corner(p) + (i - 1) + n(1) * (j - 1) + n(1) * n(2) * (k - 1)
+                ws = b%w1(p, i, 1) * b%w1(p, j, 2)
+                if (nd == 3) ws = ws * b%w1(p, k, 3)
+                gmom(1:nd, node) = gmom(1:nd, node) + ws * b%mass(p) * dv(1:nd)
+             end do
           end do
        end do
     end do

@@ -106,19 +106,27 @@ contains
     end do
   end subroutine wall_rows_behind
 
-  !> The 2D wall's coordinates of x along it: s from p0 (its projection) and the segment's length.
+  !> Where x lies along the wall towards its open ends: 2D, s from p0 along the segment (x's
+  !> projection) and the segment's length; 3D (a box face open), s from the box's low face on
+  !> the open axis and the box's extent on it (a node's support is a box along the grid axes, so
+  !> it reaches past the face when s is less than the support, whatever the wall's inclination).
   pure subroutine along_wall(w, x, s, length)
     type(mpm_wall_t), intent(in) :: w
     real(dp), intent(in) :: x(3)
     real(dp), intent(out) :: s, length
     real(dp) :: t(3)
 
+    if (w%open_axis > 0) then
+       s = x(w%open_axis) - w%lo(w%open_axis)
+       length = w%hi(w%open_axis) - w%lo(w%open_axis)
+       return
+    end if
     t = w%p1 - w%p0
     length = norm2(t)
     s = dot_product(x - w%p0, t) / length
   end subroutine along_wall
 
-  !> Is x's projection on the 2D wall within `reach` of one of its open ends (OPEN=)?
+  !> Is x within `reach` of one of the wall's open ends (OPEN=), along it (along_wall)?
   pure logical function near_open_end(w, x, reach)
     type(mpm_wall_t), intent(in) :: w
     real(dp), intent(in) :: x(3), reach
@@ -166,7 +174,7 @@ contains
   end function wall_contains
 
   !> support: how far a node's shape function reaches [m]; the nodes within it of an open end
-  !> (OPEN=, 2D) are left to the particles (mpm_wall_edges), so the wall's grid condition does
+  !> (OPEN=) are left to the particles (mpm_wall_edges), so the wall's grid condition does
   !> not reach past the end into the opening.
   subroutine wall_find_nodes(w, g, wn, support)
     type(mpm_wall_t), intent(in) :: w

@@ -96,3 +96,24 @@ def test_glass_at_rest_reads_k_and_the_mobilised_friction_of_the_glass_layers(tm
     res = glass_at_rest(tmp_path / "flat", 0.3, (0.0, 0.1), mu, 0.2, bands=2)
     assert [r["mobilised"] for r in res] == [None, None]
     assert [r["K"] for r in res] == pytest.approx([0.43, 0.43])
+
+
+def wall_box(text, name):
+    """The keyword line and the box (lo, hi) of a bounded 3D wall."""
+    m = re.search(rf"(\*MPM WALL, NAME={name}[^\n]*)\n.*\n(.*)\n(.*)\n", text)
+    return m.group(1), [float(v) for v in m.group(2).split(",")], [float(v) for v in m.group(3).split(",")]
+
+
+@pytest.mark.parametrize("case", ["concentric", "eccentric"])
+def test_open_edge_opens_the_box_faces_at_the_outlet_edge(case):
+    common = dict(cell=SMALL["cell"], outlet=SMALL["outlet"], width=SMALL["width"], fill=SMALL["fill"])
+    closed, _, _ = slab_scene(case, **common)
+    assert "OPEN=" not in closed
+    text, g, _ = slab_scene(case, open_edge=True, **common)
+    edge = g["x_out1"] if case == "concentric" else g["x_out0"]
+    for name in ("FLOOR", "OUTLET"):
+        line, lo, hi = wall_box(text, name)
+        face = re.search(r"OPEN=(X(LOW|HIGH))", line).group(1)
+        # the open face is the box's face on the outlet's edge, x = edge
+        assert (lo[0] if face == "XLOW" else hi[0]) == pytest.approx(edge, abs=1e-9)
+    assert text.count("OPEN=") == 2

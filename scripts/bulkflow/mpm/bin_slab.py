@@ -44,9 +44,12 @@ def _f(v: float) -> str:
 def slab_scene(case="concentric", sand="NDNS", gap_cells=4, cell=None, edge_cells=1, ppc=2, outlet=OUTLET,
                width=None, fill=None, density=RHO_I, wall_friction=PHI_WALL, fill_time=0.3, ramp=0.2,
                discharge_time=2.0, fill_damping=0.1, flip=0.99, cfl=0.3, field_dt=0.1, history_dt=0.01,
-               outflow_cells=2.0, glass_friction=None, young=YOUNG, pic_time=0.0, max_dilation=0.0):
+               outflow_cells=2.0, glass_friction=None, young=YOUNG, pic_time=0.0, max_dilation=0.0,
+               open_edge=False):
     """The 3D slab scene text; gap t = gap_cells cells; the glass walls' friction angle is the bin's
-    wall friction unless `glass_friction` (degrees) is given."""
+    wall friction unless `glass_friction` (degrees) is given. open_edge: the floor and the outlet
+    plate open at the outlet's edge (`*MPM WALL, OPEN=` the face of their box there, as
+    bin_scene's open_edge in 2D)."""
     if sand not in SANDS or case not in CASES:
         raise ValueError(f"sand in {SANDS}, case in {CASES}")
     if gap_cells < 1:
@@ -87,7 +90,10 @@ def slab_scene(case="concentric", sand="NDNS", gap_cells=4, cell=None, edge_cell
         lines += box((lo[0], 0.0, lo[2]), (xl, top, hi[2]))
         floor = (xl, x0)
         plate = (x0, hi[0])
-    w(f"*MPM WALL, NAME=FLOOR, FRICTION={mu:.7f}")
+    # the floor's and the plate's box faces at the outlet's edge (x1 concentric, x0 eccentric)
+    floor_open = (", OPEN=XLOW" if g["half"] else ", OPEN=XHIGH") if open_edge else ""
+    plate_open = (", OPEN=XHIGH" if g["half"] else ", OPEN=XLOW") if open_edge else ""
+    w(f"*MPM WALL, NAME=FLOOR, FRICTION={mu:.7f}{floor_open}")
     w(f"{_f(floor[0])}, 0., 0., 0., 1., 0.")
     lines += box((floor[0], lo[1], lo[2]), (floor[1], 0.0, hi[2]))
     w(f"*MPM WALL, NAME=RIGHT, FRICTION={mu:.7f}")
@@ -97,7 +103,7 @@ def slab_scene(case="concentric", sand="NDNS", gap_cells=4, cell=None, edge_cell
     w("0., 0., 0., 0., 0., 1.")
     w(f"*MPM WALL, NAME=BACK, FRICTION={mu_glass:.7f}")
     w(f"0., 0., {_f(t)}, 0., 0., -1.")
-    w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu:.7f}")
+    w(f"*MPM WALL, NAME=OUTLET, FRICTION={mu:.7f}{plate_open}")
     w(f"{_f(plate[0])}, 0., 0., 0., 1., 0.")
     lines += box((plate[0], lo[1], lo[2]), (plate[1], 0.0, hi[2]))
     w(f"*OUTFLOW, BELOW={_f(-outflow_cells * h)}")
@@ -195,6 +201,8 @@ def compare(a: argparse.Namespace) -> dict:
     if a.young is not None:
         common["young"] = a.young
     common.update(pic_time=a.pic_time, max_dilation=a.max_dilation)
+    if a.open_edge:
+        common["open_edge"] = True
     slab, g, gap = slab_scene(gap_cells=a.gap_cells, **common)
     half = 2.0 if g["half"] else 1.0
     scenes = {   # name: (scene, its file name, mass per metre of depth of the whole bin per kg)
@@ -259,6 +267,8 @@ def main(argv=None):
                    help="*MPM CONTROLS, PIC TIME=TAU [s] in every scene (0: FLIP=0.99)")
     p.add_argument("--max-dilation", type=float, default=0.0, metavar="J",
                    help="*MPM CONTROLS, MAX DILATION=J in every scene (0: off)")
+    p.add_argument("--open-edge", action="store_true",
+                   help="every scene with the floor and the outlet plate open at the outlet's edge (*MPM WALL, OPEN=)")
     a = p.parse_args(argv)
     if a.pic_time < 0 or (0 < a.max_dilation < 1) or a.max_dilation < 0 or a.edge_cells < 1:
         p.error("--pic-time >= 0, --max-dilation 0 or >= 1, --edge-cells >= 1")
@@ -266,7 +276,8 @@ def main(argv=None):
         compare(a)
         return 0
     text, _, _ = slab_scene(a.case, a.sand, a.gap_cells, cell=SMALL["cell"], ppc=a.ppc, outlet=SMALL["outlet"],
-                            width=SMALL["width"], fill=SMALL["fill"], discharge_time=a.discharge)
+                            width=SMALL["width"], fill=SMALL["fill"], discharge_time=a.discharge,
+                            open_edge=a.open_edge)
     sys.stdout.write(text)
     return 0
 
