@@ -85,12 +85,11 @@ contains
     real(dp), intent(in) :: support, dt, gravity(3), v_new(:, :)
     type(particle_block_t), intent(inout) :: b
     real(dp), intent(inout) :: gmom(:, :), force(3), dissipated, wk
-    integer :: p, i, j, k, node, nsup, nd, nc, row, nrows, rows(particle_block_size)
-    real(dp) :: x(3), xs(3), v(3), vnew(3), dv(3), normal(3), t_old, t_new, ws, sv(3), ds(3), d(particle_block_size)
+    integer :: p, i, nd, row, nrows, rows(particle_block_size), nodes(27), ns
+    real(dp) :: x(3), xs(3), v(3), vnew(3), dv(3), normal(3), t_old, t_new, weights(27), sv(3), ds(3)
+    real(dp) :: d(particle_block_size)
 
-    nsup = size(b%w1, 2)
     nd = size(b%x, 2)
-    nc = merge(nsup, 1, nd == 3)
     normal = w%normal
     ! A vectorised pre-filter first (the scalar scan of every particle was 2 % of a bin
     ! increment's CPU samples): the rows a hair wider than the first row's band, then the exact
@@ -107,16 +106,10 @@ contains
        if (nd == 3) xs = x - wall_distance(w, x) * normal
        if (.not. wall_contains(w, nd, xs, 0.0_dp)) cycle
        if (.not. near_open_end(w, xs, 2 * support)) cycle
+       call particle_stencil(b, p, n, nodes, weights, ns)
        sv = 0
-       do k = 1, nc
-          do j = 1, nsup
-             do i = 1, nsup
-                node = b%corner(p) + (i - 1) + n(1) * (j - 1) + n(1) * n(2) * (k - 1)
-                ws = b%w1(p, i, 1) * b%w1(p, j, 2)
-                if (nd == 3) ws = ws * b%w1(p, k, 3)
-                sv(1:nd) = sv(1:nd) + ws * v_new(1:nd, node)
-             end do
-          end do
+       do i = 1, ns
+          sv(1:nd) = sv(1:nd) + weights(i) * v_new(1:nd, nodes(i))
        end do
        ds = 0
        ds(1:nd) = wall_slide_velocity(w, nd, sv(1:nd)) - sv(1:nd)
@@ -133,16 +126,33 @@ contains
        t_old = norm2(v - dot_product(v, normal) * normal)
        t_new = norm2(vnew - dot_product(vnew, normal) * normal)
        dissipated = dissipated + b%mass(p) * (t_old - t_new) * t_new
-       do k = 1, nc
-          do j = 1, nsup
-             do i = 1, nsup
-                node = b%corner(p) + (i - 1) + n(1) * (j - 1) + n(1) * n(2) * (k - 1)
-                ws = b%w1(p, i, 1) * b%w1(p, j, 2)
-                if (nd == 3) ws = ws * b%w1(p, k, 3)
-                gmom(1:nd, node) = gmom(1:nd, node) + ws * b%mass(p) * dv(1:nd)
-             end do
-          end do
+       do i = 1, ns
+          gmom(1:nd, nodes(i)) = gmom(1:nd, nodes(i)) + weights(i) * b%mass(p) * dv(1:nd)
        end do
     end do
   end subroutine block_open_end_contact
+
+  !> Particle p's stencil nodes and weights S (the product of its 1D weights), in the order
+  !> i fastest, then j, then k (3D); n: grid nodes per axis. At most 3 nodes per axis (uGIMP).
+  pure subroutine particle_stencil(b, p, n, nodes, weights, ns)
+    type(particle_block_t), intent(in) :: b
+    integer, intent(in) :: p, n(3)
+    integer, intent(out) :: nodes(27), ns
+    real(dp), intent(out) :: weights(27)
+    integer :: i, j, k, nsup, nd
+
+    nsup = size(b%w1, 2)
+    nd = size(b%x, 2)
+    ns = 0
+    do k = 1, merge(nsup, 1, nd == 3)
+       do j = 1, nsup
+          do i = 1, nsup
+             ns = ns + 1
+             nodes(ns) = b%corner(p) + (i - 1) + n(1) * (j - 1) + n(1) * n(2) * (k - 1)
+             weights(ns) = b%w1(p, i, 1) * b%w1(p, j, 2)
+             if (nd == 3) weights(ns) = weights(ns) * b%w1(p, k, 3)
+          end do
+       end do
+    end do
+  end subroutine particle_stencil
 end module mpm_wall_edges

@@ -18,6 +18,7 @@ reference.
 import argparse
 import csv
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -89,6 +90,7 @@ def check_reuse(cmd, out, members, check) -> None:
     """--reuse twice into a fresh folder: the first runs every member, the second none (each line
     says it was reused, no new solver log) and writes the same values and measured times."""
     cmd = [c if c != str(cmd[cmd.index("--out") + 1]) else str(out) for c in cmd] + ["--reuse"]
+    shutil.rmtree(out, ignore_errors=True)     # a fresh folder: runs of an earlier ctest would be reused
     found = []
     for attempt in (1, 2):
         proc = subprocess.run(cmd, capture_output=True, text=True)
