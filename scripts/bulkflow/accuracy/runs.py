@@ -87,6 +87,11 @@ def deck_key(text: str, ranks: int, solver: str | None = None) -> str:
     return h.hexdigest()[:12]
 
 
+def reuse_name(stem: str, text: str, ranks: int = 1, solver: str | None = None) -> str:
+    """The name a reusable run of this deck goes under: STEM-KEY (KEY = deck_key)."""
+    return f"{stem}-{deck_key(text, ranks, solver)}"
+
+
 def run_deck_reusing(text: str, workdir: Path, name: str, ranks: int = 1,
                      solver: str | None = None) -> tuple[Timing, bool]:
     """run_deck under the name NAME-KEY (KEY = deck_key), unless a run of the same deck, rank
@@ -97,7 +102,7 @@ def run_deck_reusing(text: str, workdir: Path, name: str, ranks: int = 1,
     binary is run again."""
     workdir = Path(workdir)
     key = deck_key(text, ranks, solver)
-    name = f"{name}-{key}"
+    name = reuse_name(name, text, ranks, solver)
     stamp = workdir / f"{name}.done.json"
     if stamp.exists():
         done = json.loads(stamp.read_text())

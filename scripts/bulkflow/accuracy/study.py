@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 from .convergence import order_from_errors, order_from_values, recommend, richardson
-from .runs import deck_key, run_deck, run_deck_reusing
+from .runs import reuse_name, run_deck, run_deck_reusing
 
 TARGETS = (0.01, 0.02, 0.05)
 
@@ -46,7 +46,7 @@ def run_family(kind: dict, quick: bool, out: Path, ranks: int = 1, solver: str |
             if reuse:
                 # named by the deck's key and not the member's place: a family extended by a finer
                 # member or started with another list finds its members wherever they were
-                name = f"{kind['name'].replace('-', '_')}-{deck_key(text, ranks, solver)}"
+                name = reuse_name(kind["name"].replace("-", "_"), text, ranks, solver)
             log(f"  ... {member['label']} (member {len(rows) + 1} of {len(members)}; "
                 f"solver progress: {runs / name}.log)")
             if reuse:
