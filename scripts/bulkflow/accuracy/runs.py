@@ -9,14 +9,12 @@ import hashlib
 import importlib.util
 import json
 import re
-import resource
 import shutil
 import subprocess
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..arching.runner import mpi_environment, solver_path
+from ..arching.runner import run_measured, solver_path
 
 REPO = Path(__file__).resolve().parents[3]
 _DONE = re.compile(r"bulkflow: done, (\d+) increments")
@@ -52,16 +50,10 @@ def run_deck(text: str, workdir: Path, name: str, ranks: int = 1, solver: str | 
 
 
 def run_logged(cmd: list[str], log: Path) -> tuple[int, str, float, float]:
-    """Run a solver command line with the MPI environment, its stdout and stderr written to `log`
-    while it runs: exit status, the log's text, wall time and the CPU time (user + system) of the
-    children it started [s]."""
-    t0 = time.perf_counter()
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    """Run a solver command line (runner.run_measured), its stdout and stderr written to `log` while
+    it runs: exit status, the log's text, wall time and CPU time [s]."""
     with open(log, "w") as handle:
-        proc = subprocess.run(cmd, stdout=handle, stderr=subprocess.STDOUT, env=mpi_environment())
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+        proc, wall, cpu = run_measured(cmd, stdout=handle, stderr=subprocess.STDOUT)
     return proc.returncode, log.read_text(errors="replace"), wall, cpu
 
 

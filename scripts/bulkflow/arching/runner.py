@@ -91,15 +91,21 @@ def _last_row(history: Path) -> list[str]:
     return lines[-1].split(",")
 
 
-def run_timed(cmd: list[str], log: Path) -> tuple[subprocess.CompletedProcess, float, float]:
-    """Run a solver command line with the MPI environment: the finished process, its wall time
-    and the CPU time (user + system) of the children it started [s]; stdout and stderr go to `log`."""
+def run_measured(cmd: list[str], **kwargs) -> tuple[subprocess.CompletedProcess, float, float]:
+    """subprocess.run(cmd, **kwargs) with the MPI environment: the finished process, its wall time
+    and the CPU time (user + system) of the children it started [s]."""
     t0 = time.perf_counter()
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=mpi_environment())
+    proc = subprocess.run(cmd, env=mpi_environment(), **kwargs)
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    return proc, wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+
+
+def run_timed(cmd: list[str], log: Path) -> tuple[subprocess.CompletedProcess, float, float]:
+    """run_measured with stdout and stderr kept apart (the caller reads both) and written to `log`
+    when the run ends."""
+    proc, wall, cpu = run_measured(cmd, capture_output=True, text=True)
     log.write_text(proc.stdout + proc.stderr)
     return proc, wall, cpu
 
