@@ -25,8 +25,17 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=None, help="output folder (default out/accuracy/KIND)")
     parser.add_argument("--ranks", type=int, default=1, help="MPI ranks per run (default 1)")
     parser.add_argument("--solver", default=None, help="bulkflow binary (default BULKFLOW_BIN or build/bin/bulkflow)")
-    parser.add_argument("--criterion", default=None,
-                        help="arching-cow only: the flow criterion, passed to bulkflow.arching when it takes one")
+    parser.add_argument("--criterion", default=None, choices=arching_cow.CRITERIA,
+                        help="arching-cow only: FLOW at 3 %% of the outlet width (physical, the default) or at "
+                             "half an outlet element (half-element, the thesis's rule)")
+    parser.add_argument("--flow-rule", default=None, choices=arching_cow.FLOW_RULES,
+                        help="arching-cow only: the thesis's non-associated material (default) or Davis's "
+                             "associated material of equal strength (scripts/bulkflow/arching/README.md)")
+    parser.add_argument("--cow-case", default=None, choices=sorted(arching_cow.CASES),
+                        help="arching-cow only: thesis Case B (default) or the polymer powder (fc0 reading), 1 m")
+    parser.add_argument("--n-arcs", default=None, metavar="LIST",
+                        help="arching-cow only: the members, elements along the outlet, comma-separated "
+                             "(at least three) instead of the family's default or --quick list")
     parser.add_argument("--pic-time", type=float, default=None, metavar="TAU",
                         help="hopper-mdr, bin-tss, bin-mdr: *MPM CONTROLS, PIC TIME=TAU [s] in every member, "
                              "the PIC/FLIP blend as a rate (docs/accuracy.md); 0: FLIP=0.99 (the default of "
@@ -60,12 +69,23 @@ def main(argv=None) -> int:
     if args.ranks < 1:
         parser.error("--ranks must be at least 1")
     kind = KINDS[args.kind]
-    if args.criterion is not None:
+    suffix = ""
+    cow_options = (args.criterion, args.flow_rule, args.cow_case, args.n_arcs)
+    if any(v is not None for v in cow_options):
         if args.kind != "arching-cow":
-            parser.error("--criterion applies to arching-cow only")
-        if arching_cow.criterion_supported() is None:
-            parser.error("--criterion: this checkout's bulkflow.arching has no flow criterion option")
+            parser.error("--criterion, --flow-rule, --cow-case and --n-arcs apply to arching-cow only")
+        if args.n_arcs is not None:
+            n_arcs = n_arcs_list(args.n_arcs)
+            if isinstance(n_arcs, str):
+                parser.error(f"--n-arcs {args.n_arcs!r}: {n_arcs}")
+            arching_cow.N_ARCS = n_arcs
         arching_cow.CRITERION = args.criterion
+        arching_cow.FLOW_RULE = args.flow_rule or "nonassociated"
+        arching_cow.CASE = args.cow_case or "B"
+        kind = dict(kind, title=arching_cow.title(), expected_order=arching_cow.expected_order())
+        for value, default in ((args.cow_case, "B"), (args.flow_rule, "nonassociated"), (args.criterion, "physical")):
+            if value not in (None, default):
+                suffix += f"-{value}"
     if args.reuse and "run" in kind:
         parser.error(f"--reuse: a member of {args.kind} is a search of several runs; it cannot be reused")
     if args.pic_time is not None:
@@ -81,7 +101,6 @@ def main(argv=None) -> int:
         if isinstance(cells, str):
             parser.error(f"--edge-cells {args.edge_cells!r}: {cells}")
         MPM_FLOW[args.kind].EDGE_CELLS = MPM_FLOW[args.kind].QUICK_EDGE_CELLS = cells
-    suffix = ""
     if args.hopper_scene:
         if args.kind != "hopper-mdr":
             parser.error("--hopper-scene applies to hopper-mdr only")
@@ -158,6 +177,19 @@ def edge_cells_list(text: str, half: bool):
     if any(v < 1 or v != int(v) for v in vals):
         return "the bins' members are whole numbers k ≥ 1 (cell b/(2k + 1))"
     return [int(v) for v in vals]
+
+
+def n_arcs_list(text: str):
+    """The members of --n-arcs (at least three distinct whole numbers ≥ 4), or what is wrong (a str)."""
+    try:
+        vals = [int(v) for v in text.split(",")]
+    except ValueError:
+        return "expected comma-separated whole numbers (elements along the outlet)"
+    if len(vals) < 3 or len(set(vals)) != len(vals):
+        return "expected at least three distinct members (an observed order needs three)"
+    if any(v < 4 for v in vals):
+        return "a member needs at least 4 elements along the outlet"
+    return sorted(vals)
 
 
 def hopper_scene_keywords(items):
