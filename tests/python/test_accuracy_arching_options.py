@@ -60,3 +60,11 @@ def test_output_folder_names_the_variant(family, tmp_path, capsys, monkeypatch):
                   "--summarise-only"])
     assert "arching-cow-polymer-davis/arching-cow.json does not exist" in capsys.readouterr().err
     assert family.N_ARCS == [16, 30, 60] and family.FLOW_RULE == "davis" and family.CASE == "polymer"
+
+
+def test_table_shows_each_search_interval():
+    from bulkflow.accuracy.study import _cell_value
+
+    assert _cell_value({"value": 0.33291, "no_flow": 0.33218, "flow": 0.33364}) == "0.33291 (0.33218 .. 0.33364)"
+    assert _cell_value({"value": 7.04}) == "7.04"
+    assert _cell_value({"value": None, "tss_status": "not reached"}) == "none (not reached)"

@@ -272,8 +272,11 @@ def _cell(v) -> str:
 
 
 def _cell_value(r: dict) -> str:
-    """A member's value, or why it has none (the kind's `tss_status`-like column, else 'none')."""
+    """A member's value (with a search's interval, no flow .. flow, when it has one), or why it has none
+    (the kind's `tss_status`-like column, else 'none')."""
     if r["value"] is not None:
+        if r.get("no_flow") is not None and r.get("flow") is not None:
+            return f"{r['value']:.6g} ({r['no_flow']:.6g} .. {r['flow']:.6g})"
         return f"{r['value']:.6g}"
     return next((f"none ({r[k]})" for k in ("tss_status",) if r.get(k)), "none")
 
