@@ -86,7 +86,7 @@ contains
     type(particle_block_t), intent(inout) :: b
     real(dp), intent(inout) :: gmom(:, :), force(3), dissipated, wk
     integer :: p, i, nd, row, nrows, rows(particle_block_size), nodes(27), ns
-    real(dp) :: x(3), xs(3), v(3), vnew(3), dv(3), normal(3), t_old, t_new, weights(27), sv(3), ds(3)
+    real(dp) :: x(3), xs(3), v(3), vnew(3), dv(3), normal(3), t_old, t_new, weights(27), sv(3), ds(3), dist
     real(dp) :: d(particle_block_size)
 
     nd = size(b%x, 2)
@@ -99,11 +99,12 @@ contains
        p = rows(row)
        x = 0
        x(1:nd) = b%x(p, :)
-       if (.not. wall_distance(w, x) < 2 * b%half) cycle
+       dist = wall_distance(w, x)
+       if (.not. dist < 2 * b%half) cycle
        ! 3D: where the particle is over the plane (its foot on it), since the box bounds the
        ! plane and the nodes behind it, not the space in front; 2D: the segment's projection
        xs = x
-       if (nd == 3) xs = x - wall_distance(w, x) * normal
+       if (nd == 3) xs = x - dist * normal
        if (.not. wall_contains(w, nd, xs, 0.0_dp)) cycle
        if (.not. near_open_end(w, xs, 2 * support)) cycle
        call particle_stencil(b, p, n, nodes, weights, ns)
