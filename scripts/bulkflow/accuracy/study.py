@@ -315,6 +315,11 @@ def plot(kind: dict, rows: list[dict], summary: dict, path: Path) -> None:
         y = [r["value"] for r in rows]
         ax1.semilogx(wall, y, "o-")
         ax2.semilogx(h, y, "s-", label="measured")
+        if all(r.get("no_flow") is not None and r.get("flow") is not None for r in rows):
+            # a search's value is known only to its interval: draw it, so that a drift smaller than
+            # the bisection's tolerance is not read as one
+            ax2.errorbar(h, y, yerr=[[r["value"] - r["no_flow"] for r in rows], [r["flow"] - r["value"] for r in rows]],
+                         fmt="none", ecolor="k", capsize=4, label="search interval (no flow .. flow)")
         for ax in (ax1, ax2):
             ax.set_ylabel(kind["quantity"])
         ax2.set_title(f"{kind['quantity']} against {kind['parameter']}: no usable observed order, "
