@@ -485,6 +485,7 @@ MESHDIAG_VARIANTS = {
     "assoc": dict(psi="phi"),                             # (b) associated flow, ψ = φ
     "psi10": dict(psi=10.0),                              # (b) half way: ψ = 10°
     "davis": dict(flow_rule="davis"),                     # (b) Davis's associated material of equal strength
+    "davis-smooth": dict(flow_rule="davis", phi_w=0.0),   # (a) and (b): Davis's material, frictionless wall (no wall corner friction)
     "nobv": dict(bulk_viscosity=(0.0, 0.0)),              # bulk viscosity (∝ element size) off
     "hgstiff": dict(hourglass="stiffness"),               # (e) stiffness instead of viscous hourglass control
     "hg10": dict(hourglass_scale=10.0),                   # (e) viscous hourglass control x 10
