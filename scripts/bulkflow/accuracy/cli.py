@@ -161,15 +161,24 @@ def main(argv=None) -> int:
     return 0
 
 
+def _distinct_members(text: str, kind, what: str):
+    """The comma-separated values of `text` converted by `kind`, or what is wrong (a str): `what` when
+    one does not convert; fewer than three, or a repeated one, is refused (an observed order needs three)."""
+    try:
+        vals = [kind(v) for v in text.split(",")]
+    except ValueError:
+        return what
+    if len(vals) < 3 or len(set(vals)) != len(vals):
+        return "expected at least three distinct members (an observed order needs three)"
+    return vals
+
+
 def edge_cells_list(text: str, half: bool):
     """The members of --edge-cells (at least three, distinct), or what is wrong with the list (a str).
     half: hopper-mdr's values n + 1/2 (the outlet edge mid-cell); else whole k ≥ 1 (the bins)."""
-    try:
-        vals = [float(v) for v in text.split(",")]
-    except ValueError:
-        return "expected comma-separated numbers"
-    if len(vals) < 3 or len(set(vals)) != len(vals):
-        return "expected at least three distinct members (an observed order needs three)"
+    vals = _distinct_members(text, float, "expected comma-separated numbers")
+    if isinstance(vals, str):
+        return vals
     if half:
         if any(v < 1.5 or (v - 0.5) != int(v - 0.5) for v in vals):
             return "hopper-mdr's members are n + 1/2 with n ≥ 1 (the outlet edge mid-cell): 1.5, 2.5, …"
@@ -181,12 +190,9 @@ def edge_cells_list(text: str, half: bool):
 
 def n_arcs_list(text: str):
     """The members of --n-arcs (at least three distinct whole numbers ≥ 4), or what is wrong (a str)."""
-    try:
-        vals = [int(v) for v in text.split(",")]
-    except ValueError:
-        return "expected comma-separated whole numbers (elements along the outlet)"
-    if len(vals) < 3 or len(set(vals)) != len(vals):
-        return "expected at least three distinct members (an observed order needs three)"
+    vals = _distinct_members(text, int, "expected comma-separated whole numbers (elements along the outlet)")
+    if isinstance(vals, str):
+        return vals
     if any(v < 4 for v in vals):
         return "a member needs at least 4 elements along the outlet"
     return sorted(vals)
