@@ -117,3 +117,56 @@ def test_open_edge_opens_the_box_faces_at_the_outlet_edge(case):
         # the open face is the box's face on the outlet's edge, x = edge
         assert (lo[0] if face == "XLOW" else hi[0]) == pytest.approx(edge, abs=1e-9)
     assert text.count("OPEN=") == 2
+
+
+def _steps(text):
+    """(name, the keyword lines of the step) of every step."""
+    out = []
+    for block in text.split("*STEP, NAME=")[1:]:
+        name, _, body = block.partition("\n")
+        out.append((name, body.split("*END STEP")[0]))
+    return out
+
+
+@pytest.mark.parametrize("three_d", [False, True])
+def test_fill_in_layers_pours_by_inflow_between_the_fill_and_the_discharge(three_d):
+    from bulkflow.mpm.bin_scene import bin_scene
+    common = dict(cell=SMALL["cell"], outlet=SMALL["outlet"], width=SMALL["width"], fill=SMALL["fill"])
+    make = (lambda **k: slab_scene(**k, **common)[0]) if three_d else (lambda **k: bin_scene(**k, **common))
+    once = make()
+    assert "*INFLOW" not in once and [n for n, _ in _steps(once)] == ["FILL", "DISCHARGE"]
+    assert make(fill_layers=1) == once                   # one layer is the fill at once
+    text = make(fill_layers=4, layer_time=0.05)
+    steps = _steps(text)
+    assert [n for n, _ in steps] == ["FILL", "FILL-2", "FILL-3", "FILL-4", "DISCHARGE"]
+    # the scene's particles are the first layer only
+    region = text.split("*PARTICLES")[1].split("*MPM WALL")[0]
+    tops = [float(line.split(",")[1]) for line in region.splitlines()[1:] if line.strip()]
+    assert max(tops) == pytest.approx(SMALL["fill"] / 4)
+    for k, (name, body) in enumerate(steps[1:4], start=2):
+        assert ", 0.05\n" in body                          # layer_time
+        m = re.search(r"\*INFLOW, MATERIAL=MC-SAND, LEVEL=([0-9.]+), PPC=2\n(.*)\n", body)
+        assert float(m.group(1)) == pytest.approx(SMALL["fill"] * k / 4)
+        band = [float(v) for v in m.group(2).split(",")]
+        # the band spans the bin between its walls (and the slot in 3D), the first layer's columns
+        assert len(band) == (4 if three_d else 2)
+        assert band[0] == pytest.approx(0.0) and band[len(band) // 2] == pytest.approx(SMALL["width"] / 2)
+    assert "*INFLOW" not in steps[0][1] and "*INFLOW" not in steps[-1][1]
+    assert "OP=DELETE" in steps[-1][1]
+
+
+def test_fill_layers_must_be_one_or_more():
+    from bulkflow.mpm.bin_scene import bin_scene
+    with pytest.raises(ValueError):
+        bin_scene(fill_layers=0)
+    with pytest.raises(ValueError):
+        slab_scene(fill_layers=2, layer_time=0.0)
+
+
+def test_discharge_is_the_last_step_whatever_the_fill():
+    import numpy as np
+    from bulkflow.mpm.bin_slab import discharged_per_metre
+    hist = np.array([(1, 0.1, 0.0), (3, 0.05, 0.0), (4, 0.1, 2.0), (4, 0.2, 5.0)],
+                    dtype=[("step", float), ("step_time", float), ("MASS_OUT", float)])
+    t, m = discharged_per_metre(hist, 2.0)
+    assert t.tolist() == [0.1, 0.2] and m.tolist() == [4.0, 10.0]

@@ -27,7 +27,9 @@ Sand (thesis Table 5.3): E 8 MPa, nu 0.3, rho_i 1800 kg/m3 (or the 1600 variant)
 
 Steps: FILL (outlet closed, gravity ramped smoothly in total time, local damping so the fill
 settles), DISCHARGE (outlet wall deleted, no damping, particles 2 cells below the outlet leave
-through *OUTFLOW, no inflow: the bin empties as in the experiments).
+through *OUTFLOW, no inflow: the bin empties as in the experiments). `fill_layers` = N > 1 fills in
+N layers instead: the first placed, each further one topped up by *INFLOW in a step of its own
+(bin_steps; docs/bins.md says what it changes).
 
 `side_friction` = t writes `*MPM SIDE FRICTION, GAP=t, FRICTION=tan(phi_w)` (the front and back
 glass walls of the quasi-2D bin, issue 20 point 2); the keyword needs a solver that has it.
@@ -121,10 +123,14 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
               psi_max=PSI_MAX, wall_friction=PHI_WALL, right_wall_friction=None, floor_friction=None,
               fill_time=0.3, ramp=0.2, discharge_time=8.0, fill_damping=0.1, flip=0.99, cfl=0.3,
               shape="GIMP", field_dt=0.1, history_dt=0.01, outflow_cells=2.0, side_friction=None,
-              max_dilation=0.0, pic_time=0.0, open_edge=False, title=""):
-    """The scene text (Abaqus keyword syntax). Angles in degrees; see the module text."""
+              max_dilation=0.0, pic_time=0.0, open_edge=False, fill_layers=1, layer_time=0.1, title=""):
+    """The scene text (Abaqus keyword syntax). Angles in degrees; see the module text.
+    fill_layers > 1: the fill poured in that many layers of layer_time each (bin_steps)."""
     if sand not in SANDS:
         raise ValueError(f"sand must be one of {SANDS}")
+    if not layer_time > 0:
+        raise ValueError("layer_time must be > 0")
+    levels = layer_levels(fill, fill_layers)
     g = bin_geometry(case, cell, outlet, width, fill, edge_cells)
     h = g["cell"]
     mu = math.tan(math.radians(wall_friction))
@@ -155,7 +161,7 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     _material(w, sand, density, young, poisson, phi_cv, psi_max, eps)
     w(f"*PARTICLES, MATERIAL=MC-SAND, PPC={ppc}, TYPE=BOX")
     w(f"{g['x_left']:.9f}, 0.")
-    w(f"{g['x_right']:.9f}, {fill:.9f}")
+    w(f"{g['x_right']:.9f}, {levels[0]:.9f}")
     x0, x1 = g["x_out0"], g["x_out1"]
     # OPEN= (docs/keywords.md): the floor holds the particles, not the nodes, at the outlet's edge,
     # and so does the outlet plate at its end there while the fill rests on both
@@ -183,17 +189,45 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     w("** gravity: ramped in the fill step, then on at full value (amplitude in total time)")
     w("*AMPLITUDE, NAME=RAMP, DEFINITION=SMOOTH STEP, TIME=TOTAL TIME")
     w(f"0., 0., {ramp:g}, 1.")
-    lines += bin_steps(fill_time, discharge_time, field_dt, history_dt)
+    layers = (levels, layer_time, ppc, f"{g['x_left']:.9f}, {g['x_right']:.9f}") if fill_layers > 1 else None
+    lines += bin_steps(fill_time, discharge_time, field_dt, history_dt, layers=layers)
     return "\n".join(lines) + "\n"
 
 
-def bin_steps(fill_time, discharge_time, field_dt, history_dt, gravity="9.81, 0., -1.", fields="S, SDV"):
-    """The two steps of a bin run (2D scenes and the 3D slab): FILL with the outlet closed and
+def layer_levels(fill, fill_layers):
+    """The free-surface level after each layer of a layered fill (the last one is `fill`)."""
+    if fill_layers < 1:
+        raise ValueError("fill_layers must be >= 1")
+    return [fill * k / fill_layers for k in range(1, fill_layers + 1)]
+
+
+def fill_end(fill_time, fill_layers=1, layer_time=0.1):
+    """Total time at the end of the fill (the state at rest that the outlet opens on)."""
+    return fill_time + (fill_layers - 1) * layer_time
+
+
+def bin_steps(fill_time, discharge_time, field_dt, history_dt, gravity="9.81, 0., -1.", fields="S, SDV",
+              layers=None):
+    """The steps of a bin run (2D scenes and the 3D slab): FILL with the outlet closed and
     gravity ramped by the amplitude RAMP (one field frame at its end), DISCHARGE with the outlet
-    wall deleted and no damping."""
+    wall deleted and no damping.
+
+    layers = (levels, layer_time, ppc, band): a layered fill. The scene's particles are the first
+    layer only; after FILL, one step FILL-k of layer_time per further level, in which *INFLOW
+    (band: its data line) tops the sand up to that level while the layers below settle under the
+    added weight. The sand below slides down the glass and the walls a little at every layer,
+    which mobilises their friction as pouring does (docs/bins.md, "2D with side friction against
+    a 3D slab")."""
     lines = []
-    steps = (("FILL", "Outlet closed: the fill settles under gravity", fill_time,
-              ["*DLOAD, AMPLITUDE=RAMP", f", GRAV, {gravity}"], fill_time),
+    fill_steps = [("FILL", "Outlet closed: the fill settles under gravity", fill_time,
+                   ["*DLOAD, AMPLITUDE=RAMP", f", GRAV, {gravity}"], fill_time)]
+    if layers is not None:
+        levels, layer_time, ppc, band = layers
+        for k, level in enumerate(levels[1:], start=2):
+            fill_steps.append((f"FILL-{k}", f"Outlet closed: layer {k} of {len(levels)} poured to y = {level:.6g} m",
+                               layer_time, [f"*INFLOW, MATERIAL=MC-SAND, LEVEL={level:.9f}, PPC={ppc}", band],
+                               layer_time))
+    steps = (*fill_steps,
              ("DISCHARGE", "Outlet open: the bin empties through the outlet", discharge_time,
               ["*MPM CONTROLS, DAMPING=0.", "*MPM WALL, NAME=OUTLET, OP=DELETE"], field_dt))
     for name, text, period, loads, frame_dt in steps:
@@ -224,6 +258,9 @@ def main(argv=None):
     p.add_argument("--right-wall-friction", type=float, help="eccentric: right wall friction angle [deg]")
     p.add_argument("--floor-friction", type=float, help="bottom friction angle [deg] (default: the wall's)")
     p.add_argument("--fill-time", type=float, default=0.3)
+    p.add_argument("--fill-layers", type=int, default=1,
+                   help="pour the fill in N layers: the first placed, the others by *INFLOW (default 1: placed at once)")
+    p.add_argument("--layer-time", type=float, default=0.1, help="--fill-layers: time per further layer [s]")
     p.add_argument("--ramp", type=float, default=0.2, help="gravity ramp time [s]")
     p.add_argument("--discharge-time", type=float, default=8.0)
     p.add_argument("--shape", choices=["GIMP", "LINEAR"], default="GIMP")
@@ -252,7 +289,8 @@ def main(argv=None):
                          floor_friction=a.floor_friction, fill_time=a.fill_time, ramp=a.ramp,
                          discharge_time=a.discharge_time, shape=a.shape, flip=a.flip, cfl=a.cfl,
                          field_dt=a.field_dt, history_dt=a.history_dt, side_friction=a.side_friction,
-                         max_dilation=a.max_dilation, pic_time=a.pic_time, open_edge=a.open_edge)
+                         max_dilation=a.max_dilation, pic_time=a.pic_time, open_edge=a.open_edge,
+                         fill_layers=a.fill_layers, layer_time=a.layer_time)
     except ValueError as e:
         p.error(str(e))
     with open(a.output, "w") as f:
