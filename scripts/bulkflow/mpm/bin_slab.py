@@ -13,7 +13,8 @@ model's symmetry plane x = 0 is mirrored as in 2D.
 
 `compare` runs four scenes with the same grid in x-y, the same material and steps: the 2D bin
 without side friction, the 2D bin with `*MPM SIDE FRICTION, GAP=t`, the 3D slab, and the slab with
-frictionless glass (what 3D alone changes, apart from the glass's friction), and prints the
+frictionless glass (what 3D alone changes, apart from the glass's friction; `--no-smooth-slab`
+leaves it out), and prints the
 discharged mass per metre of depth against time and the mean discharge rate of each over the
 discharge step's second half (kg/s per m of depth, whole bin: a half model's mass doubled, the
 slab's divided by t). Results: docs/bins.md ("2D with side friction against a 3D slab").
@@ -218,9 +219,10 @@ def compare(a: argparse.Namespace) -> dict:
         "2D": (bin_scene(**common), "bin_2d", half),
         "2D + side friction": (bin_scene(side_friction=gap, **common), "bin_2d_side_friction", half),
         "3D slab": (slab, "bin_slab_3d", half / gap),
-        "3D slab, smooth glass": (slab_scene(gap_cells=a.gap_cells, glass_friction=0.0, **common)[0],
-                                  "bin_slab_3d_smooth", half / gap),
     }
+    if not a.no_smooth_slab:
+        scenes["3D slab, smooth glass"] = (slab_scene(gap_cells=a.gap_cells, glass_friction=0.0, **common)[0],
+                                           "bin_slab_3d_smooth", half / gap)
     out = Path(a.out)
     rows = {}
     # the base stress at rest is read between the outlet's edge and the side wall, 3 cells from each
@@ -279,6 +281,8 @@ def main(argv=None):
                    help="*MPM CONTROLS, MAX DILATION=J in every scene (0: off)")
     p.add_argument("--open-edge", action="store_true",
                    help="every scene with the floor and the outlet plate open at the outlet's edge (*MPM WALL, OPEN=)")
+    p.add_argument("--no-smooth-slab", action="store_true",
+                   help="compare: leave out the slab with frictionless glass (a second 3D run)")
     p.add_argument("--fill-layers", type=int, default=1,
                    help="every scene poured in N layers (first placed, the others by *INFLOW; default 1: at once)")
     p.add_argument("--layer-time", type=float, default=0.1, help="--fill-layers: time per further layer [s]")
