@@ -129,7 +129,7 @@ def _steps(text):
 
 
 @pytest.mark.parametrize("three_d", [False, True])
-def test_fill_in_layers_pours_by_inflow_between_the_fill_and_the_discharge(three_d):
+def test_fill_in_layers_tops_up_by_inflow_between_the_fill_and_the_discharge(three_d):
     from bulkflow.mpm.bin_scene import bin_scene
     common = dict(cell=SMALL["cell"], outlet=SMALL["outlet"], width=SMALL["width"], fill=SMALL["fill"])
     make = (lambda **k: slab_scene(**k, **common)[0]) if three_d else (lambda **k: bin_scene(**k, **common))

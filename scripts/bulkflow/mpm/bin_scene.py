@@ -125,12 +125,10 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
               shape="GIMP", field_dt=0.1, history_dt=0.01, outflow_cells=2.0, side_friction=None,
               max_dilation=0.0, pic_time=0.0, open_edge=False, fill_layers=1, layer_time=0.1, title=""):
     """The scene text (Abaqus keyword syntax). Angles in degrees; see the module text.
-    fill_layers > 1: the fill poured in that many layers of layer_time each (bin_steps)."""
+    fill_layers > 1: the fill in that many layers of layer_time each (bin_steps)."""
     if sand not in SANDS:
         raise ValueError(f"sand must be one of {SANDS}")
-    if not layer_time > 0:
-        raise ValueError("layer_time must be > 0")
-    levels = layer_levels(fill, fill_layers)
+    levels = layer_levels(fill, fill_layers, layer_time)
     g = bin_geometry(case, cell, outlet, width, fill, edge_cells)
     h = g["cell"]
     mu = math.tan(math.radians(wall_friction))
@@ -194,10 +192,12 @@ def bin_scene(case="concentric", sand="NDNS", cell=None, edge_cells=1, ppc=2, ou
     return "\n".join(lines) + "\n"
 
 
-def layer_levels(fill, fill_layers):
+def layer_levels(fill, fill_layers, layer_time):
     """The free-surface level after each layer of a layered fill (the last one is `fill`)."""
     if fill_layers < 1:
         raise ValueError("fill_layers must be >= 1")
+    if not layer_time > 0:
+        raise ValueError("layer_time must be > 0")
     return [fill * k / fill_layers for k in range(1, fill_layers + 1)]
 
 
@@ -215,16 +215,16 @@ def bin_steps(fill_time, discharge_time, field_dt, history_dt, gravity="9.81, 0.
     layers = (levels, layer_time, ppc, band): a layered fill. The scene's particles are the first
     layer only; after FILL, one step FILL-k of layer_time per further level, in which *INFLOW
     (band: its data line) tops the sand up to that level while the layers below settle under the
-    added weight. The sand below slides down the glass and the walls a little at every layer,
-    which mobilises their friction as pouring does (docs/bins.md, "2D with side friction against
-    a 3D slab")."""
+    added weight. Not pouring: inflow stacks particles on each column with its top's velocity,
+    and the walls' friction ends less mobilised than after the fill at once (measured:
+    docs/bins.md, "2D with side friction against a 3D slab")."""
     lines = []
     fill_steps = [("FILL", "Outlet closed: the fill settles under gravity", fill_time,
                    ["*DLOAD, AMPLITUDE=RAMP", f", GRAV, {gravity}"], fill_time)]
     if layers is not None:
         levels, layer_time, ppc, band = layers
         for k, level in enumerate(levels[1:], start=2):
-            fill_steps.append((f"FILL-{k}", f"Outlet closed: layer {k} of {len(levels)} poured to y = {level:.6g} m",
+            fill_steps.append((f"FILL-{k}", f"Outlet closed: layer {k} of {len(levels)} filled to y = {level:.6g} m",
                                layer_time, [f"*INFLOW, MATERIAL=MC-SAND, LEVEL={level:.9f}, PPC={ppc}", band],
                                layer_time))
     steps = (*fill_steps,
@@ -259,7 +259,7 @@ def main(argv=None):
     p.add_argument("--floor-friction", type=float, help="bottom friction angle [deg] (default: the wall's)")
     p.add_argument("--fill-time", type=float, default=0.3)
     p.add_argument("--fill-layers", type=int, default=1,
-                   help="pour the fill in N layers: the first placed, the others by *INFLOW (default 1: placed at once)")
+                   help="fill in N layers: the first placed, the others by *INFLOW (default 1: placed at once)")
     p.add_argument("--layer-time", type=float, default=0.1, help="--fill-layers: time per further layer [s]")
     p.add_argument("--ramp", type=float, default=0.2, help="gravity ramp time [s]")
     p.add_argument("--discharge-time", type=float, default=8.0)

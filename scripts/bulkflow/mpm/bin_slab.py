@@ -50,17 +50,15 @@ def slab_scene(case="concentric", sand="NDNS", gap_cells=4, cell=None, edge_cell
     """The 3D slab scene text; gap t = gap_cells cells; the glass walls' friction angle is the bin's
     wall friction unless `glass_friction` (degrees) is given. open_edge: the floor and the outlet
     plate open at the outlet's edge (`*MPM WALL, OPEN=` the face of their box there, as
-    bin_scene's open_edge in 2D). fill_layers > 1: poured in layers (bin_scene.bin_steps)."""
+    bin_scene's open_edge in 2D). fill_layers > 1: filled in layers (bin_scene.bin_steps)."""
     if sand not in SANDS or case not in CASES:
         raise ValueError(f"sand in {SANDS}, case in {CASES}")
-    if not layer_time > 0:
-        raise ValueError("layer_time must be > 0")
     if gap_cells < 1:
         raise ValueError("gap_cells must be >= 1")
     kw = {k: v for k, v in dict(width=width, fill=fill).items() if v is not None}
     g = bin_geometry(case, cell, outlet, edge_cells=edge_cells, **kw)
     h, fill_h = g["cell"], g["fill"]
-    levels = layer_levels(fill_h, fill_layers)
+    levels = layer_levels(fill_h, fill_layers, layer_time)
     t = gap_cells * h
     mu = math.tan(math.radians(wall_friction))
     mu_glass = math.tan(math.radians(wall_friction if glass_friction is None else glass_friction))
@@ -187,7 +185,7 @@ def glass_at_rest(base: Path, time_at_rest: float, x_range: tuple[float, float],
 
 def discharged_per_metre(hist: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
     """Discharge-step time and the discharged mass per metre of depth (whole bin); the discharge
-    is the last step (after one or, poured in layers, several fill steps)."""
+    is the last step (after one or, filled in layers, several fill steps)."""
     d = hist["step"] == hist["step"].max()
     t = hist["step_time"][d]
     return t, scale * hist["MASS_OUT"][d]
@@ -239,7 +237,7 @@ def compare(a: argparse.Namespace) -> dict:
           f"PPC {a.ppc}, E {common.get('young', YOUNG) / 1e6:g} MPa"
           + (f", PIC TIME {a.pic_time:g} s" if a.pic_time > 0 else "")
           + (f", MAX DILATION {a.max_dilation:g}" if a.max_dilation > 0 else "")
-          + (f", poured in {a.fill_layers} layers of {a.layer_time:g} s" if a.fill_layers > 1 else "")
+          + (f", filled in {a.fill_layers} layers of {a.layer_time:g} s" if a.fill_layers > 1 else "")
           + f"), glass walls tan({PHI_WALL:g} deg), gap {gap * 1e3:.4g} mm; {a.discharge:g} s of discharge")
     print("  scene                  base sigma_yy at rest [Pa]  vs 3D slab | MDR [kg/s/m]  vs 3D slab | "
           "discharged [kg/m]  wall [s]")
@@ -284,7 +282,7 @@ def main(argv=None):
     p.add_argument("--no-smooth-slab", action="store_true",
                    help="compare: leave out the slab with frictionless glass (a second 3D run)")
     p.add_argument("--fill-layers", type=int, default=1,
-                   help="every scene poured in N layers (first placed, the others by *INFLOW; default 1: at once)")
+                   help="every scene filled in N layers (first placed, the others by *INFLOW; default 1: at once)")
     p.add_argument("--layer-time", type=float, default=0.1, help="--fill-layers: time per further layer [s]")
     a = p.parse_args(argv)
     if a.pic_time < 0 or (0 < a.max_dilation < 1) or a.max_dilation < 0 or a.edge_cells < 1:
